@@ -1,0 +1,163 @@
+// hfmpm: run a scene (coupler + sides), run a coupler that waits for sides
+// started by hand, or validate a scene. Thin: parse, load, run, report.
+#include <google/protobuf/text_format.h>
+
+#include <iomanip>
+#include <iostream>
+#include <map>
+
+#include "hfmpm/coupling/coupler.hpp"
+#include "hfmpm/coupling/scene_loader.hpp"
+#include "prescribed_fluid_side.hpp"
+#include "prescribed_solid_side.hpp"
+
+namespace {
+
+using namespace hfmpm;
+
+constexpr const char* kUsage = R"(usage:
+  hfmpm run SCENE [--out DIR] [--set KEY=VALUE]... [--transport ipc|tcp|inproc] [--quiet]
+      Start the coupler and both sides, run SCENE to its end time, write DIR/history.csv.
+  hfmpm coupler SCENE --bind ENDPOINT [--out DIR] [--set KEY=VALUE]... [--quiet]
+      Run the coupler only and wait for the sides to join, e.g. from other hosts:
+        hfmpm coupler s.scene --bind tcp://0.0.0.0:5555
+        hfmpm-prescribed-solid --connect tcp://COUPLER_HOST:5555   (on the solid's host)
+        hfmpm-prescribed-fluid --connect tcp://COUPLER_HOST:5555   (on the fluid's host)
+  hfmpm validate SCENE [--set KEY=VALUE]...
+      Check SCENE and print it with every default filled in.
+
+options:
+  --out DIR            output directory (default: hfmpm-out/SCENE_NAME)
+  --set KEY=VALUE      override one scene value, e.g. --set time.end_s=2
+                       --set coupling.transport=TCP; repeated fields take [a, b]
+  --transport T        same as --set coupling.transport=T (ipc, tcp or inproc)
+  --solid-program P    run another solid implementation (speaks docs/protocol.md)
+  --fluid-program P    run another fluid implementation
+  --quiet              no progress line
+exit status: 0 success, 1 run failed, 2 bad scene or command line
+)";
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::unique_ptr<coupling::SideModel> make_inproc_side(protocol::Role role, const scene::Scene&) {
+  if (role == protocol::SOLID) return solid::make_prescribed_solid_side();
+  return fluid::make_prescribed_fluid_side();
+}
+
+// Sets every unset scalar that has a default, in every message present, so
+// that 'validate' shows each value the run will use.
+void fill_defaults(google::protobuf::Message& message) {
+  const auto* type = message.GetDescriptor();
+  const auto* reflection = message.GetReflection();
+  for (int i = 0; i < type->field_count(); ++i) {
+    const auto* field = type->field(i);
+    if (field->is_repeated() || field->real_containing_oneof()) {
+      if (field->real_containing_oneof() && field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE &&
+          reflection->HasField(message, field)) {
+        fill_defaults(*reflection->MutableMessage(&message, field));
+      }
+      continue;
+    }
+    if (field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE) {
+      if (reflection->HasField(message, field)) fill_defaults(*reflection->MutableMessage(&message, field));
+    } else if (!reflection->HasField(message, field) && field->has_default_value()) {
+      std::string text;
+      google::protobuf::TextFormat::PrintFieldValueToString(message, field, -1, &text);
+      google::protobuf::TextFormat::ParseFieldValueFromString(text, field, &message);
+    }
+  }
+}
+
+int run(const std::string& command, const std::vector<std::string>& args) {
+  std::string scene_path, out, bind;
+  std::vector<std::string> overrides;
+  coupling::RunOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw UsageError("option " + arg + " needs a value");
+      return args[++i];
+    };
+    if (arg == "--out") out = value();
+    else if (arg == "--set") overrides.push_back(value());
+    else if (arg == "--bind") bind = value();
+    else if (arg == "--quiet") options.progress = false;
+    else if (arg == "--solid-program") options.solid_program = value();
+    else if (arg == "--fluid-program") options.fluid_program = value();
+    else if (arg == "--transport") {
+      static const std::map<std::string, std::string> names{{"ipc", "IPC"}, {"tcp", "TCP"}, {"inproc", "INPROC"}};
+      const std::string t = value();
+      if (!names.count(t)) throw UsageError("--transport " + t + ": allowed: ipc, tcp, inproc");
+      overrides.push_back("coupling.transport=" + names.at(t));
+    } else if (!arg.empty() && arg[0] == '-') throw UsageError("unknown option '" + arg + "'");
+    else if (scene_path.empty()) scene_path = arg;
+    else throw UsageError("more than one scene given ('" + scene_path + "' and '" + arg + "')");
+  }
+  if (scene_path.empty()) throw UsageError("no scene file given");
+  const scene::Scene scene = coupling::load_scene(scene_path, overrides);
+  if (command == "validate") {
+    scene::Scene filled = scene;
+    filled.mutable_time();  // blocks whose every field has a default
+    filled.mutable_output();
+    filled.mutable_coupling();
+    fill_defaults(filled);
+    std::string text;
+    google::protobuf::TextFormat::PrintToString(filled, &text);
+    std::cout << "# " << scene_path << ": valid\n" << text;
+    return 0;
+  }
+  if (command == "coupler") {
+    if (bind.empty()) throw UsageError("'hfmpm coupler' needs --bind ENDPOINT (e.g. tcp://0.0.0.0:5555)");
+    options.launch = false;
+    options.bind_endpoint = bind;
+  } else if (!bind.empty()) {
+    throw UsageError("--bind is for 'hfmpm coupler'; 'hfmpm run' chooses its own endpoints");
+  }
+  options.output_dir = out.empty() ? "hfmpm-out/" + (scene.name().empty() ? std::string("run") : scene.name()) : out;
+  options.scene_path = scene_path;
+  options.overrides = overrides;
+  options.inproc_factory = make_inproc_side;
+  const auto summary = coupling::run_coupled(scene, options);
+  if (!summary.ok) {
+    std::cerr << "hfmpm: run failed: " << summary.error << "\n"
+              << "hfmpm: output written so far is in " << options.output_dir << "\n";
+    return 1;
+  }
+  std::cout << std::setprecision(4) << "hfmpm: done: " << summary.steps << " steps to t = " << summary.t << " s in "
+            << summary.wall_s << " s wall (" << static_cast<double>(summary.steps) / summary.stepping_wall_s
+            << " steps/s)\n"
+            << "  compute: solid " << summary.solid_compute_s << " s, fluid " << summary.fluid_compute_s
+            << " s; coupling overhead " << summary.overhead_per_step_us() << " us/step\n"
+            << "  results: " << options.output_dir << "/history.csv (run manifest: " << options.output_dir
+            << "/run.json)\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::cout << kUsage;
+    return args.empty() ? 2 : 0;
+  }
+  const std::string command = args[0];
+  args.erase(args.begin());
+  try {
+    if (command != "run" && command != "coupler" && command != "validate") {
+      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, validate");
+    }
+    return run(command, args);
+  } catch (const UsageError& e) {
+    std::cerr << "hfmpm: " << e.what() << "\n" << kUsage;
+    return 2;
+  } catch (const coupling::SceneError& e) {
+    std::cerr << "hfmpm: invalid scene:\n" << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "hfmpm: " << e.what() << "\n";
+    return 1;
+  }
+}

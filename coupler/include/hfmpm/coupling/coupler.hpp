@@ -1,0 +1,54 @@
+// The coupler: the control plane of a run. It launches (or waits for) the
+// sides, handshakes, owns the clock and dt, schedules steps, collects reports
+// and heartbeats, writes history.csv and the run manifest, and stops
+// everything on any failure. It has no physics.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/scene.pb.h"
+
+namespace hfmpm::coupling {
+
+// Builds a side model for the in-process transport.
+using ModelFactory = std::function<std::unique_ptr<SideModel>(protocol::Role role, const scene::Scene& scene)>;
+
+struct RunOptions {
+  std::string output_dir = "hfmpm-out";
+  // true: start the sides (processes, or threads with INPROC). false: bind
+  // `bind_endpoint` and wait for sides started by hand (--connect).
+  bool launch = true;
+  std::string bind_endpoint;   // join mode: e.g. tcp://0.0.0.0:5555 or ipc:///tmp/x
+  std::string executable_dir;  // where the side programs are; default: beside this program
+  std::string solid_program;   // override the solid program (another implementation)
+  std::string fluid_program;
+  ModelFactory inproc_factory;  // required for INPROC
+  bool progress = true;         // progress line on stderr
+  std::string scene_path;       // for the manifest
+  std::vector<std::string> overrides;
+  std::function<void(const std::string&)> on_bound;  // told the bound control endpoint
+};
+
+struct RunSummary {
+  bool ok = false;
+  std::string error;  // names the failed side and step
+  std::uint64_t steps = 0;
+  std::uint64_t commands = 0;
+  double t = 0;
+  double wall_s = 0;          // whole run
+  double stepping_wall_s = 0; // from the first StepCommand to the last report
+  double solid_compute_s = 0, fluid_compute_s = 0;
+  double solid_exchange_s = 0, fluid_exchange_s = 0;
+  // stepping_wall_s minus the slower side's compute time, per step.
+  double overhead_per_step_us() const;
+};
+
+// Runs a validated scene. Never throws for run failures: they are in the summary.
+RunSummary run_coupled(const scene::Scene& scene, const RunOptions& options);
+
+}  // namespace hfmpm::coupling

@@ -1,0 +1,49 @@
+// Scene files: Protobuf text format of hfmpm.scene.Scene (proto/hfmpm/scene.proto).
+// Load, apply command-line overrides, validate every value; a bad scene
+// throws SceneError whose text names the file, line, key, value and what is
+// allowed, before any process starts.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hfmpm/scene.pb.h"
+
+namespace hfmpm::coupling {
+
+class SceneError : public std::runtime_error {
+ public:
+  explicit SceneError(const std::vector<std::string>& problems);
+  const std::vector<std::string>& problems() const { return problems_; }
+
+ private:
+  std::vector<std::string> problems_;
+};
+
+// One value that breaks a rule: key path ("coupling.exchange_interval",
+// "solid.prescribed_crack.mouth_opening_m.table.t[2]"), its value as text
+// ("" if missing), and what is allowed.
+struct SceneProblem {
+  std::string key;
+  std::string value;
+  std::string allowed;
+};
+
+// Reads `path`, applies `overrides` ("key.path=value", in order), validates.
+scene::Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+// Same from text; `name` stands for the file in messages.
+scene::Scene parse_scene(const std::string& text, const std::string& name,
+                         const std::vector<std::string>& overrides = {});
+
+// Sets one value by its dotted key path; throws SceneError for an unknown key
+// or a value of the wrong type. Repeated fields take "[a, b]" and are replaced.
+void apply_override(scene::Scene& scene, const std::string& assignment);
+
+// Every rule the scene breaks (empty if valid).
+std::vector<SceneProblem> validate(const scene::Scene& scene);
+
+// Effective values used by the coupler.
+double output_interval(const scene::Scene& scene);
+
+}  // namespace hfmpm::coupling

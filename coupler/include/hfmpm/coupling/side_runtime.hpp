@@ -1,0 +1,77 @@
+// The generic side of the protocol: handshake, data plane, step loop,
+// heartbeat, errors and shutdown. A side (stand-in or real physics) supplies a
+// SideModel; everything about sockets and messages lives here, so any model
+// speaks exactly the same protocol (docs/protocol.md).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+#include <zmq.hpp>
+
+#include "hfmpm/exchange.hpp"
+#include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/scene.pb.h"
+
+namespace hfmpm::coupling {
+
+// A bad value in the scene or on the command line, found by a side.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// What a side's physics must provide. Called from one thread only.
+class SideModel {
+ public:
+  virtual ~SideModel() = default;
+  // Once, with the validated scene; throws InputError for anything it cannot run.
+  virtual void setup(const scene::Scene& scene, const std::string& output_dir) = 0;
+  virtual double stable_dt() const = 0;  // s; +inf if unlimited
+  virtual void advance(double dt) = 0;   // one explicit step
+  // Fill the payload of the frame this side sends (crack for a solid, fluid for a fluid).
+  virtual void publish(protocol::DataFrame& frame) = 0;
+  // Apply a frame from the peer; throws proto::ProtocolError if it is inconsistent.
+  virtual void receive(const protocol::DataFrame& frame) = 0;
+  virtual SideDiagnostics diagnostics() const = 0;
+  virtual void write_output(std::uint64_t /*frame*/, double /*t*/) {}
+  virtual void finish() {}
+};
+
+// Test hook: make a side fail on purpose at a step ("KIND@STEP").
+struct Fault {
+  enum class Kind { None, Exit, Crash, Hang, Freeze, Garbage, NaN };
+  Kind kind = Kind::None;
+  std::uint64_t step = 0;
+  static Fault parse(const std::string& text);  // throws InputError
+};
+
+struct SideOptions {
+  protocol::Role role = protocol::ROLE_UNSPECIFIED;
+  std::string control_endpoint;          // the coupler's control socket
+  std::string implementation;            // e.g. "hfmpm-prescribed-solid"
+  std::string implementation_version = "0.1.0";
+  std::vector<std::string> capabilities;
+  std::string advertise_host;            // tcp: host the peer can reach this side at
+  std::string output_dir;                // overrides the coupler's output_dir
+  double welcome_timeout_s = 60;         // the coupler must answer Hello within this
+  zmq::context_t* context = nullptr;     // shared context (in-process mode); own one if null
+  std::uint32_t protocol_version = proto::kProtocolVersion;  // tests claim others
+  Fault fault;
+};
+
+// Exit codes of a side.
+enum SideExit : int { kSideOk = 0, kSideFailed = 1, kSideInput = 2, kSideProtocol = 3, kSideCouplerLost = 4 };
+
+// Runs the side until Shutdown or failure; never throws. Returns a SideExit.
+int run_side(SideModel& model, const SideOptions& options);
+
+// A thin main: parses --connect, --out, --advertise-host, --fault,
+// --protocol-version, --welcome-timeout, --help; runs the model.
+int side_main(int argc, char** argv, protocol::Role role, const std::string& implementation,
+              const std::vector<std::string>& capabilities,
+              const std::function<std::unique_ptr<SideModel>()>& make_model);
+
+}  // namespace hfmpm::coupling

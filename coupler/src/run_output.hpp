@@ -1,0 +1,61 @@
+// What the coupler writes: history.csv (one row per output interval, flushed
+// at once so it stays readable after any failure), the run manifest, its log
+// and the progress line.
+#pragma once
+
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include "hfmpm/exchange.hpp"
+
+namespace hfmpm::coupling {
+
+class History {
+ public:
+  explicit History(const std::string& path);
+  void write(double t, std::uint64_t step, double dt, const SideDiagnostics& solid, const SideDiagnostics& fluid,
+             double wall_s);
+
+ private:
+  std::ofstream out_;
+};
+
+// run.json: written at start, rewritten at each change of state and at the end.
+class Manifest {
+ public:
+  explicit Manifest(std::string path) : path_(std::move(path)) {}
+  void set(const std::string& key, const std::string& value) { fields_[key] = quoted(value); }
+  void set_number(const std::string& key, double value);
+  void save() const;
+
+ private:
+  static std::string quoted(const std::string& value);
+  std::string path_;
+  std::map<std::string, std::string> fields_;
+};
+
+// Log lines to stderr and to the run's coupler.log.
+class Log {
+ public:
+  void open(const std::string& path);
+  void operator()(const std::string& line);
+
+ private:
+  std::ofstream file_;
+};
+
+class Progress {
+ public:
+  explicit Progress(bool enabled, double end_time);
+  void update(double t, std::uint64_t step, double wall_s);
+  void finish();
+
+ private:
+  bool enabled_, tty_;
+  double end_time_, last_print_ = -1e9;
+  bool printed_ = false;
+};
+
+}  // namespace hfmpm::coupling

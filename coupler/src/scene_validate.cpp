@@ -1,0 +1,203 @@
+// The rules a scene must satisfy before any process starts. Each rule names
+// the key and what is allowed; the loader adds file and line.
+#include <cmath>
+#include <limits>
+#include <regex>
+#include <sstream>
+
+#include "hfmpm/coupling/scene_loader.hpp"
+
+namespace hfmpm::coupling {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string text(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+class Checker {
+ public:
+  void missing(const std::string& key, const std::string& what) { problems_.push_back({key, "", what}); }
+  void bad(const std::string& key, const std::string& value, const std::string& allowed) {
+    problems_.push_back({key, value, allowed});
+  }
+  // lo < v (or lo <= v) and v <= hi, finite.
+  void range(const std::string& key, double v, double lo, double hi, bool lo_open, const std::string& unit) {
+    const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
+    if (!ok) {
+      std::string allowed = std::string("a finite value ") + (lo_open ? "> " : ">= ") + text(lo);
+      if (std::isfinite(hi)) allowed += " and <= " + text(hi);
+      if (!unit.empty()) allowed += " (" + unit + ")";
+      bad(key, text(v), allowed);
+    }
+  }
+  void positive(const std::string& key, double v, const std::string& unit) {
+    range(key, v, 0, kInf, true, unit);
+  }
+  void non_negative(const std::string& key, double v, const std::string& unit) {
+    range(key, v, 0, kInf, false, unit);
+  }
+  std::vector<SceneProblem> take() { return std::move(problems_); }
+
+ private:
+  std::vector<SceneProblem> problems_;
+};
+
+// `min_value`: the smallest value the function may take (e.g. 0 for an opening).
+void check_time_function(Checker& c, const std::string& key, const scene::TimeFunction& f, double min_value,
+                         const std::string& unit) {
+  switch (f.kind_case()) {
+    case scene::TimeFunction::KIND_NOT_SET:
+      c.missing(key, "one of constant, ramp, table, power");
+      return;
+    case scene::TimeFunction::kConstant:
+      c.range(key + ".constant", f.constant(), min_value, kInf, false, unit);
+      return;
+    case scene::TimeFunction::kRamp: {
+      const auto& r = f.ramp();
+      if (!r.has_t1()) c.missing(key + ".ramp.t1", "the ramp's end time t1 (s), > t0");
+      else c.range(key + ".ramp.t1", r.t1(), r.t0(), kInf, true, "s, > ramp.t0");
+      c.range(key + ".ramp.t0", r.t0(), -kInf, kInf, false, "s");
+      c.range(key + ".ramp.v0", r.v0(), min_value, kInf, false, unit);
+      if (!r.has_v1()) c.missing(key + ".ramp.v1", "the ramp's end value v1 (" + unit + ")");
+      else c.range(key + ".ramp.v1", r.v1(), min_value, kInf, false, unit);
+      return;
+    }
+    case scene::TimeFunction::kTable: {
+      const auto& t = f.table();
+      if (t.t_size() < 2 || t.t_size() != t.v_size()) {
+        c.bad(key + ".table", std::to_string(t.t_size()) + " times, " + std::to_string(t.v_size()) + " values",
+              "at least 2 points, with as many values 'v' as times 't'");
+        return;
+      }
+      for (int i = 0; i < t.t_size(); ++i) {
+        const std::string k = key + ".table.t[" + std::to_string(i) + "]";
+        if (!std::isfinite(t.t(i))) c.bad(k, text(t.t(i)), "a finite time (s)");
+        else if (i > 0 && !(t.t(i) > t.t(i - 1))) c.bad(k, text(t.t(i)), "times strictly increasing, > " + text(t.t(i - 1)));
+        c.range(key + ".table.v[" + std::to_string(i) + "]", t.v(i), min_value, kInf, false, unit);
+      }
+      return;
+    }
+    case scene::TimeFunction::kPower: {
+      const auto& p = f.power();
+      if (!p.has_scale()) c.missing(key + ".power.scale", "the scale (" + unit + ")");
+      else c.range(key + ".power.scale", p.scale(), min_value, kInf, false, unit);
+      c.positive(key + ".power.t_ref", p.t_ref(), "s");
+      if (!p.has_exponent()) c.missing(key + ".power.exponent", "the exponent, >= 0");
+      else c.non_negative(key + ".power.exponent", p.exponent(), "");
+      return;
+    }
+  }
+}
+
+void check_time(Checker& c, const scene::Scene& s) {
+  if (!s.has_time() || !s.time().has_end_s()) {
+    c.missing("time.end_s", "the end time in seconds, > 0");
+  } else {
+    c.positive("time.end_s", s.time().end_s(), "s");
+  }
+  c.range("time.safety_factor", s.time().safety_factor(), 0, 1, true, "fraction of the smallest stable step");
+  if (s.time().max_steps() == 0) c.bad("time.max_steps", "0", "an integer >= 1");
+  c.range("output.interval_s", s.output().interval_s(), 0, s.time().has_end_s() ? s.time().end_s() : kInf,
+          false, "s, 0 for end_s / 100");
+}
+
+void check_coupling(Checker& c, const scene::Coupling& k) {
+  if (k.transport() == scene::Coupling::TRANSPORT_UNSPECIFIED) {
+    c.bad("coupling.transport", "TRANSPORT_UNSPECIFIED", "IPC, TCP or INPROC");
+  }
+  if (k.scheme() == scene::Coupling::SCHEME_UNSPECIFIED) {
+    c.bad("coupling.scheme", "SCHEME_UNSPECIFIED", "JACOBI or GAUSS_SEIDEL");
+  }
+  if (k.exchange_interval() < 1 || k.exchange_interval() > 10000) {
+    c.bad("coupling.exchange_interval", std::to_string(k.exchange_interval()), "an integer from 1 to 10000 (steps)");
+  }
+  if (k.control_interval() < 1 || k.control_interval() > 1000000) {
+    c.bad("coupling.control_interval", std::to_string(k.control_interval()), "an integer from 1 to 1000000 (steps)");
+  }
+  c.range("coupling.heartbeat_interval_s", k.heartbeat_interval_s(), 0.01, 60, false, "s");
+  c.range("coupling.heartbeat_timeout_s", k.heartbeat_timeout_s(), 2 * k.heartbeat_interval_s(), 3600, true,
+          "s, more than twice coupling.heartbeat_interval_s");
+  c.range("coupling.step_timeout_s", k.step_timeout_s(), 0, 86400, true, "s");
+  c.range("coupling.join_timeout_s", k.join_timeout_s(), 0, 86400, true, "s");
+  if (k.tcp_host().empty()) c.bad("coupling.tcp_host", "\"\"", "a host name or address to bind, e.g. 127.0.0.1");
+  if (k.spin_us() > 1000000) c.bad("coupling.spin_us", std::to_string(k.spin_us()), "0 to 1000000 (us)");
+}
+
+void check_prescribed_crack(Checker& c, const scene::PrescribedCrack& p) {
+  const std::string key = "solid.prescribed_crack.";
+  c.range(key + "mouth_x_m", p.mouth_x_m(), -kInf, kInf, false, "m");
+  c.range(key + "mouth_y_m", p.mouth_y_m(), -kInf, kInf, false, "m");
+  c.range(key + "angle_deg", p.angle_deg(), -180, 180, false, "degrees");
+  if (!p.has_initial_length_m()) c.missing(key + "initial_length_m", "the initial crack length (m), > 0");
+  else c.positive(key + "initial_length_m", p.initial_length_m(), "m");
+  c.non_negative(key + "growth_speed_m_per_s", p.growth_speed_m_per_s(), "m/s");
+  const double max_length = p.has_max_length_m() ? p.max_length_m() : p.initial_length_m();
+  if (p.has_max_length_m()) {
+    c.range(key + "max_length_m", p.max_length_m(), p.initial_length_m(), kInf, false,
+            "m, >= initial_length_m");
+  } else if (p.growth_speed_m_per_s() > 0) {
+    c.missing(key + "max_length_m", "the length where growth stops (m), >= initial_length_m, with growth_speed_m_per_s > 0");
+  }
+  if (!p.has_spacing_m()) {
+    c.missing(key + "spacing_m", "the crack-particle spacing (m), > 0");
+  } else {
+    c.range(key + "spacing_m", p.spacing_m(), 0, p.initial_length_m(), true, "m, at most initial_length_m");
+    if (std::isfinite(max_length) && p.spacing_m() > 0 && max_length / p.spacing_m() > 1e6) {
+      c.bad(key + "spacing_m", text(p.spacing_m()), "at most 1e6 crack particles up to max_length_m");
+    }
+  }
+  if (!p.has_mouth_opening_m()) c.missing(key + "mouth_opening_m", "the mouth opening w(t) (m), a TimeFunction");
+  else check_time_function(c, key + "mouth_opening_m", p.mouth_opening_m(), 0.0, "m");
+  if (p.profile() == scene::PrescribedCrack::PROFILE_UNSPECIFIED) {
+    c.bad(key + "profile", "PROFILE_UNSPECIFIED", "ELLIPTIC or UNIFORM");
+  }
+  if (!p.has_stable_dt_s()) c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
+  else c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
+}
+
+void check_prescribed_pressure(Checker& c, const scene::PrescribedPressure& p) {
+  const std::string key = "fluid.prescribed_pressure.";
+  if (!p.has_inlet_pressure_pa()) c.missing(key + "inlet_pressure_pa", "the inlet pressure p(t) (Pa), a TimeFunction");
+  else check_time_function(c, key + "inlet_pressure_pa", p.inlet_pressure_pa(), 0.0, "Pa");
+  if (p.profile() == scene::PrescribedPressure::PROFILE_UNSPECIFIED) {
+    c.bad(key + "profile", "PROFILE_UNSPECIFIED", "UNIFORM or LINEAR");
+  }
+  c.range(key + "front_fraction", p.front_fraction(), 0, 1, true, "fraction of the crack length");
+  if (!p.has_stable_dt_s()) c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
+  else c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
+}
+
+}  // namespace
+
+std::vector<SceneProblem> validate(const scene::Scene& s) {
+  Checker c;
+  if (s.has_name() && !std::regex_match(s.name(), std::regex("[A-Za-z0-9_.-]+"))) {
+    c.bad("name", "\"" + s.name() + "\"", "letters, digits, '_', '.', '-' (it is used in file names)");
+  }
+  check_time(c, s);
+  check_coupling(c, s.coupling());
+  if (!s.has_solid() || s.solid().model_case() == scene::Solid::MODEL_NOT_SET) {
+    c.missing("solid", "a solid model: solid { prescribed_crack { ... } }");
+  } else if (s.solid().has_prescribed_crack()) {
+    check_prescribed_crack(c, s.solid().prescribed_crack());
+  }
+  if (s.has_fluid()) {
+    if (s.fluid().model_case() == scene::Fluid::MODEL_NOT_SET) {
+      c.missing("fluid", "a fluid model: fluid { prescribed_pressure { ... } }, or no fluid block for a dry run");
+    } else if (s.fluid().has_prescribed_pressure()) {
+      check_prescribed_pressure(c, s.fluid().prescribed_pressure());
+    }
+  }
+  return c.take();
+}
+
+double output_interval(const scene::Scene& scene) {
+  const double interval = scene.output().interval_s();
+  return interval > 0 ? interval : scene.time().end_s() / 100.0;
+}
+
+}  // namespace hfmpm::coupling

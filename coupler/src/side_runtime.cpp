@@ -1,0 +1,489 @@
+#include "hfmpm/coupling/side_runtime.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <thread>
+
+#include "exchange_log.hpp"
+#include "hfmpm/coupling/transport.hpp"
+#include "hfmpm/proto/convert.hpp"
+
+namespace hfmpm::coupling {
+namespace {
+
+using std::chrono::microseconds;
+
+// The coupler asked this side to stop.
+struct ShutdownRequested {
+  bool error = false;
+};
+// Nothing from the coupler (not even a heartbeat) for the heartbeat timeout.
+struct CouplerLost {
+  std::string what;
+};
+
+microseconds to_us(double seconds) { return microseconds(static_cast<std::int64_t>(seconds * 1e6)); }
+
+std::string host_name() {
+  char buffer[256] = {};
+  return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
+}
+
+// Sends Heartbeat on its own socket at a fixed interval until stopped.
+class HeartbeatThread {
+ public:
+  HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role, double interval_s,
+                  const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting)
+      : thread_([this, &context, endpoint, role, interval_s, &step, &waiting] {
+          zmq::socket_t socket(context, zmq::socket_type::dealer);
+          socket.set(zmq::sockopt::linger, 0);
+          socket.set(zmq::sockopt::routing_id, std::string(proto::role_name(role)) + ".hb");
+          socket.connect(endpoint);
+          std::uint64_t sequence = 0;
+          std::unique_lock lock(mutex_);
+          while (!stop_) {
+            protocol::Envelope envelope;
+            auto* beat = envelope.mutable_heartbeat();
+            beat->set_role(role);
+            beat->set_sequence(++sequence);
+            beat->set_step(step.load());
+            beat->set_waiting_for_peer(waiting.load());
+            (void)socket.send(zmq::buffer(proto::encode(envelope)), zmq::send_flags::dontwait);
+            wake_.wait_for(lock, to_us(interval_s), [this] { return stop_; });
+          }
+        }) {}
+  ~HeartbeatThread() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  HeartbeatThread(const HeartbeatThread&) = delete;
+  HeartbeatThread& operator=(const HeartbeatThread&) = delete;
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+class SideRuntime {
+ public:
+  SideRuntime(SideModel& model, const SideOptions& options)
+      : model_(model),
+        options_(options),
+        own_context_(options.context ? nullptr : std::make_unique<zmq::context_t>(1)),
+        context_(options.context ? *options.context : *own_context_),
+        control_(context_, zmq::socket_type::dealer),
+        role_(std::string(proto::role_name(options.role))),
+        peer_(options.role == protocol::SOLID ? "fluid" : "solid") {
+    control_.set(zmq::sockopt::linger, kLingerMs);
+    control_.set(zmq::sockopt::routing_id, role_);
+    control_.connect(options.control_endpoint);
+  }
+
+  int run() {
+    try {
+      handshake();
+      start();
+      loop();
+      model_.finish();
+      return kSideOk;
+    } catch (const ShutdownRequested&) {
+      model_.finish();
+      return kSideOk;
+    } catch (const CouplerLost& lost) {
+      std::cerr << role_ << ": " << lost.what << "; exiting\n";
+      return kSideCouplerLost;
+    } catch (const proto::ProtocolError& e) {
+      return fail("protocol", e.what(), kSideProtocol);
+    } catch (const InputError& e) {
+      return fail("input", e.what(), kSideInput);
+    } catch (const std::exception& e) {
+      return fail("side", e.what(), kSideFailed);
+    }
+  }
+
+ private:
+  int fail(const std::string& what, const std::string& message, int code) {
+    std::cerr << role_ << " side error (" << what << ") at step " << step_ << ": " << message << "\n";
+    try {
+      protocol::Envelope envelope;
+      auto* error = envelope.mutable_error();
+      error->set_who(options_.role);
+      error->set_what(what);
+      error->set_where("step " + std::to_string(step_));
+      error->set_message(message);
+      error->set_step(step_);
+      send(control_, envelope);
+    } catch (...) {
+      // The coupler may already be gone; the exit code still tells.
+    }
+    return code;
+  }
+
+  // ------------------------------------------------------------ handshake
+  void handshake() {
+    protocol::Envelope hello_envelope;
+    auto* hello = hello_envelope.mutable_hello();
+    hello->set_role(options_.role);
+    hello->set_protocol_version(options_.protocol_version);
+    hello->set_implementation(options_.implementation);
+    hello->set_implementation_version(options_.implementation_version);
+    for (const auto& c : options_.capabilities) hello->add_capabilities(c);
+    hello->set_host(host_name());
+    hello->set_pid(getpid());
+    send(control_, hello_envelope);
+
+    const auto deadline = Clock::now() + to_us(options_.welcome_timeout_s);
+    while (true) {
+      const auto left = std::chrono::duration_cast<microseconds>(deadline - Clock::now());
+      if (left.count() <= 0) {
+        throw CouplerLost{"no answer to Hello from the coupler at " + options_.control_endpoint + " within " +
+                          std::to_string(options_.welcome_timeout_s) + " s"};
+      }
+      auto envelope = receive(control_, "the coupler", left);
+      if (!envelope || envelope->has_heartbeat()) continue;
+      if (envelope->has_reject()) {
+        std::cerr << role_ << ": the coupler rejected this side: " << envelope->reject().reason() << "\n";
+        throw ShutdownRejected{};
+      }
+      if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
+      if (!envelope->has_welcome()) unexpected(*envelope, "Welcome or Reject");
+      welcome_ = envelope->welcome();
+      return;
+    }
+  }
+
+  [[noreturn]] void unexpected(const protocol::Envelope& envelope, const std::string& expected) {
+    throw proto::ProtocolError("unexpected " + std::string(proto::body_name(envelope)) +
+                               " message from the coupler while waiting for " + expected);
+  }
+
+  void start() {
+    const auto& scene = welcome_.scene();
+    heartbeat_timeout_ = to_us(scene.coupling().heartbeat_timeout_s());
+    spin_ = microseconds(scene.coupling().spin_us());
+    exchange_interval_ = std::max(1u, scene.coupling().exchange_interval());
+    gauss_seidel_ = scene.coupling().scheme() == scene::Coupling::GAUSS_SEIDEL;
+
+    std::string output_dir = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
+    if (output_dir.empty()) output_dir = ".";
+    std::filesystem::create_directories(output_dir);
+    model_.setup(scene, output_dir);
+    if (scene.output().exchange_log()) log_ = std::make_unique<ExchangeLog>(output_dir, role_);
+
+    heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role,
+                                                   scene.coupling().heartbeat_interval_s(), heartbeat_step_,
+                                                   waiting_for_peer_);
+    last_from_coupler_ = Clock::now();
+
+    const auto mode = welcome_.data_plane().mode();
+    has_peer_ = mode == protocol::DataPlane::BIND || mode == protocol::DataPlane::CONNECT;
+    if (has_peer_) {
+      data_.emplace(context_, zmq::socket_type::pair);
+      data_->set(zmq::sockopt::linger, kLingerMs);
+      if (mode == protocol::DataPlane::BIND) {
+        data_->bind(welcome_.data_plane().endpoint());
+        std::string host = options_.advertise_host;
+        if (host.empty()) {
+          host = tcp_host(options_.control_endpoint);
+          if (host.empty() || host == "*" || host == "0.0.0.0") host = host_name();
+        }
+        std::string bound = data_->get(zmq::sockopt::last_endpoint);
+        if (tcp_host(bound) == "0.0.0.0") bound = advertise(bound, host);
+        protocol::Envelope listening;
+        listening.mutable_listening()->set_data_endpoint(bound);
+        send(control_, listening);
+      } else {
+        data_->connect(welcome_.data_plane().endpoint());
+      }
+      // Initial exchange (step 0): the solid goes first, the fluid builds its
+      // grid from the crack before it can answer.
+      if (options_.role == protocol::SOLID) {
+        publish();
+        consume(0);
+      } else {
+        consume(0);
+        publish();
+      }
+    }
+    protocol::Envelope ready;
+    ready.mutable_ready()->set_stable_dt(model_.stable_dt());
+    proto::to_proto(model_.diagnostics(), ready.mutable_ready()->mutable_diagnostics());
+    send(control_, ready);
+  }
+
+  // ------------------------------------------------------------ step loop
+  void loop() {
+    while (true) {
+      const auto envelope = next_command();
+      if (!envelope.has_step_command()) unexpected(envelope, "StepCommand or Shutdown");
+      execute(envelope.step_command());
+    }
+  }
+
+  // Next message from the coupler that is not a heartbeat. Shutdown throws.
+  protocol::Envelope next_command() {
+    while (true) {
+      auto envelope = receive(control_, "the coupler", heartbeat_timeout_);
+      if (!envelope) {
+        if (Clock::now() - last_from_coupler_ > heartbeat_timeout_) {
+          throw CouplerLost{"nothing from the coupler for " +
+                            std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) + " s"};
+        }
+        continue;
+      }
+      last_from_coupler_ = Clock::now();
+      if (envelope->has_heartbeat()) continue;
+      if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
+      return *envelope;
+    }
+  }
+
+  void check_command(const protocol::StepCommand& command) const {
+    if (command.first_step() != step_) {
+      throw proto::ProtocolError("StepCommand starts at step " + std::to_string(command.first_step()) +
+                                 " but this side is at step " + std::to_string(step_));
+    }
+    if (!(std::isfinite(command.dt()) && command.dt() > 0)) {
+      throw proto::ProtocolError("StepCommand dt = " + std::to_string(command.dt()) + " s; dt must be finite and > 0");
+    }
+    if (command.num_steps() == 0 || (has_peer_ && command.num_steps() % exchange_interval_ != 0)) {
+      throw proto::ProtocolError("StepCommand num_steps = " + std::to_string(command.num_steps()) +
+                                 "; it must be >= 1 and a multiple of the exchange interval " +
+                                 std::to_string(exchange_interval_));
+    }
+    if (std::abs(command.t() - t_) > 1e-9 * std::max(1.0, std::abs(t_))) {
+      throw proto::ProtocolError("StepCommand t = " + std::to_string(command.t()) + " s but this side is at t = " +
+                                 std::to_string(t_) + " s");
+    }
+  }
+
+  void execute(const protocol::StepCommand& command) {
+    check_command(command);
+    t_ = command.t();
+    double compute_s = 0, exchange_s = 0;
+    const bool fluid_waits_first = gauss_seidel_ && options_.role == protocol::FLUID;
+    for (std::uint32_t i = 0; i < command.num_steps(); ++i) {
+      if (has_peer_ && fluid_waits_first && step_ % exchange_interval_ == 0) {
+        const auto start = Clock::now();
+        consume(step_ + exchange_interval_);
+        exchange_s += seconds_since(start);
+      }
+      inject_fault(step_ + 1);
+      const auto start = Clock::now();
+      model_.advance(command.dt());
+      ++step_;
+      heartbeat_step_ = step_;
+      t_ += command.dt();
+      compute_s += seconds_since(start);
+      if (has_peer_ && step_ % exchange_interval_ == 0) {
+        const auto exchange_start = Clock::now();
+        publish();
+        if (!fluid_waits_first) consume(step_);
+        exchange_s += seconds_since(exchange_start);
+      }
+    }
+    if (command.write_output()) model_.write_output(command.output_frame(), t_);
+
+    protocol::Envelope envelope;
+    auto* report = envelope.mutable_step_report();
+    report->set_step(step_);
+    report->set_t(t_);
+    report->set_stable_dt(model_.stable_dt());
+    report->set_status(protocol::StepReport::OK);
+    proto::to_proto(model_.diagnostics(), report->mutable_diagnostics());
+    report->set_compute_s(compute_s);
+    report->set_exchange_s(exchange_s);
+    send(control_, envelope);
+  }
+
+  // ----------------------------------------------------------- data plane
+  void publish() {
+    protocol::Envelope envelope;
+    auto* frame = envelope.mutable_data();
+    frame->set_step(step_);
+    frame->set_t(t_);
+    model_.publish(*frame);
+    if (poison_next_frame_) {
+      poison_next_frame_ = false;
+      if (frame->has_crack() && frame->crack().cracks_size() > 0) {
+        frame->mutable_crack()->mutable_cracks(0)->set_width(0, std::numeric_limits<double>::quiet_NaN());
+      } else if (frame->has_fluid() && frame->fluid().cracks_size() > 0) {
+        frame->mutable_fluid()->mutable_cracks(0)->set_pressure(0, std::numeric_limits<double>::quiet_NaN());
+      }
+    }
+    send(*data_, envelope);
+  }
+
+  // Waits for the peer's frame of step `expected`, watching the coupler meanwhile.
+  void consume(std::uint64_t expected) {
+    struct Waiting {
+      std::atomic<bool>& flag;
+      explicit Waiting(std::atomic<bool>& f) : flag(f) { flag = true; }
+      ~Waiting() { flag = false; }
+    } waiting(waiting_for_peer_);
+    zmq::pollitem_t items[] = {{data_->handle(), 0, ZMQ_POLLIN, 0}, {control_.handle(), 0, ZMQ_POLLIN, 0}};
+    const auto spin_end = Clock::now() + spin_;
+    while (true) {
+      const bool spinning = Clock::now() < spin_end;
+      const auto timeout = spinning ? std::chrono::milliseconds(0)
+                                    : std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_);
+      zmq::poll(items, 2, timeout);
+      if (items[0].revents & ZMQ_POLLIN) {
+        auto envelope = receive(*data_, "the " + peer_ + " side (data plane)", microseconds(0));
+        if (!envelope) continue;
+        check_frame(*envelope, expected);
+        if (log_) log_->write(envelope->data());
+        model_.receive(envelope->data());
+        return;
+      }
+      if (items[1].revents & ZMQ_POLLIN) {
+        auto envelope = receive(control_, "the coupler", microseconds(0));
+        if (!envelope) continue;
+        last_from_coupler_ = Clock::now();
+        if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
+        if (!envelope->has_heartbeat()) unexpected(*envelope, "data from the " + peer_ + " side");
+        continue;
+      }
+      if (!spinning && Clock::now() - last_from_coupler_ > heartbeat_timeout_) {
+        throw CouplerLost{"nothing from the coupler for " +
+                          std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) +
+                          " s while waiting for the " + peer_ + " side's data"};
+      }
+    }
+  }
+
+  void check_frame(const protocol::Envelope& envelope, std::uint64_t expected) const {
+    const std::string from = "the " + peer_ + " side";
+    if (!envelope.has_data()) {
+      throw proto::ProtocolError("unexpected " + std::string(proto::body_name(envelope)) + " message from " + from +
+                                 " on the data plane; only DataFrame is allowed there");
+    }
+    const auto& frame = envelope.data();
+    const bool right_payload = options_.role == protocol::SOLID ? frame.has_fluid() : frame.has_crack();
+    if (!right_payload) {
+      throw proto::ProtocolError("DataFrame from " + from + " carries " +
+                                 (frame.has_crack() ? "a CrackState" : frame.has_fluid() ? "a FluidState" : "nothing") +
+                                 "; a " + peer_ + " side sends " +
+                                 (options_.role == protocol::SOLID ? "FluidState" : "CrackState"));
+    }
+    if (frame.step() != expected) {
+      throw proto::ProtocolError("DataFrame from " + from + " is for step " + std::to_string(frame.step()) +
+                                 " but step " + std::to_string(expected) + " was due");
+    }
+  }
+
+  // ---------------------------------------------------------------- faults
+  void inject_fault(std::uint64_t step) {
+    const auto& fault = options_.fault;
+    if (fault.kind == Fault::Kind::None || fault.step != step) return;
+    std::cerr << role_ << ": injecting fault at step " << step << "\n";
+    switch (fault.kind) {
+      case Fault::Kind::Exit:
+        std::_Exit(7);
+      case Fault::Kind::Crash:
+        std::abort();
+      case Fault::Kind::Hang:
+        while (true) std::this_thread::sleep_for(std::chrono::seconds(1));
+      case Fault::Kind::Freeze:
+        std::raise(SIGSTOP);
+        break;
+      case Fault::Kind::Garbage: {
+        const std::string garbage = "\xff\x01garbage\x00\x7f not an envelope";
+        (void)control_.send(zmq::buffer(garbage), zmq::send_flags::none);
+        if (data_) (void)data_->send(zmq::buffer(garbage), zmq::send_flags::none);
+        break;
+      }
+      case Fault::Kind::NaN:
+        poison_next_frame_ = true;
+        break;
+      case Fault::Kind::None:
+        break;
+    }
+  }
+
+ public:
+  // Rejected at the handshake: not an error of this side's making, but not a run either.
+  struct ShutdownRejected {};
+
+ private:
+  SideModel& model_;
+  SideOptions options_;
+  std::unique_ptr<zmq::context_t> own_context_;
+  zmq::context_t& context_;
+  zmq::socket_t control_;
+  std::optional<zmq::socket_t> data_;
+  std::string role_, peer_;
+  protocol::Welcome welcome_;
+  std::unique_ptr<HeartbeatThread> heartbeat_;
+  std::unique_ptr<ExchangeLog> log_;
+  std::atomic<std::uint64_t> heartbeat_step_{0};
+  std::atomic<bool> waiting_for_peer_{false};
+  Clock::time_point last_from_coupler_ = Clock::now();
+  microseconds heartbeat_timeout_{3'000'000};
+  microseconds spin_{0};
+  std::uint32_t exchange_interval_ = 1;
+  bool gauss_seidel_ = false;
+  bool has_peer_ = false;
+  bool poison_next_frame_ = false;
+  std::uint64_t step_ = 0;
+  double t_ = 0;
+};
+
+}  // namespace
+
+Fault Fault::parse(const std::string& text) {
+  const auto at = text.find('@');
+  const std::string kind = text.substr(0, at);
+  Fault fault;
+  if (kind == "exit") fault.kind = Kind::Exit;
+  else if (kind == "crash") fault.kind = Kind::Crash;
+  else if (kind == "hang") fault.kind = Kind::Hang;
+  else if (kind == "freeze") fault.kind = Kind::Freeze;
+  else if (kind == "garbage") fault.kind = Kind::Garbage;
+  else if (kind == "nan") fault.kind = Kind::NaN;
+  else {
+    throw InputError("--fault '" + text + "': unknown kind '" + kind +
+                     "'; allowed: exit, crash, hang, freeze, garbage, nan, as KIND@STEP");
+  }
+  try {
+    if (at == std::string::npos) throw std::invalid_argument("no step");
+    std::size_t used = 0;
+    fault.step = std::stoull(text.substr(at + 1), &used);
+    if (used != text.size() - at - 1 || fault.step == 0) throw std::invalid_argument("bad step");
+  } catch (const std::exception&) {
+    throw InputError("--fault '" + text + "': expected KIND@STEP with STEP a positive integer");
+  }
+  return fault;
+}
+
+int run_side(SideModel& model, const SideOptions& options) {
+  try {
+    SideRuntime runtime(model, options);
+    try {
+      return runtime.run();
+    } catch (const SideRuntime::ShutdownRejected&) {
+      return kSideProtocol;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << proto::role_name(options.role) << " side: " << e.what() << "\n";
+    return kSideFailed;
+  }
+}
+
+}  // namespace hfmpm::coupling

@@ -1,0 +1,61 @@
+// Plain C++ types that cross between a physics library and its protocol
+// adapter. No Protobuf or ZeroMQ here: the physics libraries see only these.
+// Units are SI; 2D quantities are per unit thickness.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace hfmpm {
+
+using Vec2 = Eigen::Vector2d;
+
+// What the solid publishes about one crack after a step (DESIGN section 1).
+// Arrays are ordered from the mouth (or one end) to the tip, all of size().
+struct CrackGeometry {
+  std::uint32_t crack_id = 0;
+  std::vector<std::uint64_t> ids;  // stable crack-particle ids
+  std::vector<Vec2> position;      // m, crack-plane position
+  std::vector<Vec2> normal;        // unit normal towards the "above" side
+  std::vector<double> width;       // m, opening, >= 0
+  std::vector<char> tip;           // 1 at a tip
+  bool grew = false;               // ids appended since the previous publication
+
+  std::size_t size() const { return ids.size(); }
+};
+
+// What the fluid publishes about one crack after a step.
+struct CrackPressure {
+  std::uint32_t crack_id = 0;
+  std::vector<std::uint64_t> ids;  // crack-particle ids, same order as the geometry
+  std::vector<double> pressure;    // Pa, >= 0, 0 beyond the front
+  double front_position = 0;       // m, arc length from the mouth
+  double inlet_flux = 0;           // m^2/s
+  double fluid_volume = 0;         // m^2
+
+  std::size_t size() const { return ids.size(); }
+};
+
+// Scalars a side reports to the coupler after a StepCommand (history.csv).
+struct SideDiagnostics {
+  double kinetic_energy = 0;   // J/m
+  double crack_length = 0;     // m
+  double mouth_opening = 0;    // m
+  double crack_face_load = 0;  // N/m
+  double inlet_pressure = 0;   // Pa
+  double injected_volume = 0;  // m^2
+  double fluid_volume = 0;     // m^2
+  double front_position = 0;   // m
+  std::uint32_t crack_particles = 0;
+  std::uint32_t fluid_particles = 0;
+};
+
+// Arc length of each point of a polyline from its first point.
+inline std::vector<double> arc_length(const std::vector<Vec2>& points) {
+  std::vector<double> s(points.size(), 0.0);
+  for (std::size_t i = 1; i < points.size(); ++i) s[i] = s[i - 1] + (points[i] - points[i - 1]).norm();
+  return s;
+}
+
+}  // namespace hfmpm

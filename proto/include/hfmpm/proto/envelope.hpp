@@ -1,0 +1,32 @@
+// Encoding and decoding of the one top-level message, with errors that say
+// what arrived and from whom. Nothing read from a socket is trusted.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "hfmpm/protocol.pb.h"
+
+namespace hfmpm::proto {
+
+inline constexpr std::uint32_t kProtocolVersion = protocol::CURRENT;
+
+// A message that breaks the protocol: malformed, unexpected, or inconsistent.
+class ProtocolError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+std::string encode(const protocol::Envelope& envelope);
+
+// Parses one frame; throws ProtocolError naming `from` if the bytes are not an
+// Envelope with a body, or carry fields this version does not know.
+protocol::Envelope decode(const void* data, std::size_t size, std::string_view from);
+
+// "hello", "step_command", ... or "empty" for an envelope without a body.
+std::string_view body_name(const protocol::Envelope& envelope);
+std::string_view role_name(protocol::Role role);
+
+}  // namespace hfmpm::proto

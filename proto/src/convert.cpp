@@ -1,0 +1,165 @@
+#include <cmath>
+#include <string>
+#include <unordered_set>
+
+#include "hfmpm/proto/convert.hpp"
+
+namespace hfmpm::proto {
+namespace {
+
+[[noreturn]] void fail(std::string_view message_type, std::uint32_t crack_id, const std::string& what) {
+  throw ProtocolError(std::string(message_type) + " crack " + std::to_string(crack_id) + ": " + what);
+}
+
+template <class Repeated>
+void check_length(std::string_view type, std::uint32_t crack_id, const char* name, const Repeated& array,
+                  int expected) {
+  if (array.size() != expected) {
+    fail(type, crack_id,
+         std::string("array '") + name + "' has " + std::to_string(array.size()) + " entries but 'ids' has " +
+             std::to_string(expected) + "; every per-particle array must match 'ids'");
+  }
+}
+
+template <class Repeated>
+void check_finite(std::string_view type, std::uint32_t crack_id, const char* name, const Repeated& array) {
+  for (int i = 0; i < array.size(); ++i) {
+    if (!std::isfinite(array[i])) {
+      fail(type, crack_id, std::string("'") + name + "[" + std::to_string(i) + "]' is not finite");
+    }
+  }
+}
+
+template <class Repeated>
+void check_unique_ids(std::string_view type, std::uint32_t crack_id, const Repeated& ids) {
+  std::unordered_set<std::uint64_t> seen;
+  seen.reserve(static_cast<std::size_t>(ids.size()));
+  for (int i = 0; i < ids.size(); ++i) {
+    if (!seen.insert(ids[i]).second) {
+      fail(type, crack_id, "id " + std::to_string(ids[i]) + " appears twice (at index " + std::to_string(i) + ")");
+    }
+  }
+}
+
+}  // namespace
+
+void to_proto(const CrackGeometry& crack, protocol::CrackState::Crack* out) {
+  const int n = static_cast<int>(crack.size());
+  out->Clear();
+  out->set_crack_id(crack.crack_id);
+  out->set_grew(crack.grew);
+  out->mutable_ids()->Add(crack.ids.begin(), crack.ids.end());
+  for (auto* a : {out->mutable_x(), out->mutable_y(), out->mutable_nx(), out->mutable_ny()}) a->Reserve(n);
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    out->add_x(crack.position[k].x());
+    out->add_y(crack.position[k].y());
+    out->add_nx(crack.normal[k].x());
+    out->add_ny(crack.normal[k].y());
+  }
+  out->mutable_width()->Add(crack.width.begin(), crack.width.end());
+  out->mutable_tip()->Reserve(n);
+  for (char t : crack.tip) out->add_tip(t != 0);
+}
+
+CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
+  constexpr std::string_view type = "CrackState";
+  const std::uint32_t id = crack.crack_id();
+  const int n = crack.ids_size();
+  if (n < 2) fail(type, id, "a crack needs at least 2 crack particles, got " + std::to_string(n));
+  check_length(type, id, "x", crack.x(), n);
+  check_length(type, id, "y", crack.y(), n);
+  check_length(type, id, "nx", crack.nx(), n);
+  check_length(type, id, "ny", crack.ny(), n);
+  check_length(type, id, "width", crack.width(), n);
+  check_length(type, id, "tip", crack.tip(), n);
+  check_finite(type, id, "x", crack.x());
+  check_finite(type, id, "y", crack.y());
+  check_finite(type, id, "nx", crack.nx());
+  check_finite(type, id, "ny", crack.ny());
+  check_finite(type, id, "width", crack.width());
+  check_unique_ids(type, id, crack.ids());
+
+  CrackGeometry out;
+  out.crack_id = id;
+  out.grew = crack.grew();
+  out.ids.assign(crack.ids().begin(), crack.ids().end());
+  out.width.assign(crack.width().begin(), crack.width().end());
+  out.position.resize(static_cast<std::size_t>(n));
+  out.normal.resize(static_cast<std::size_t>(n));
+  out.tip.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    out.position[k] = Vec2(crack.x(i), crack.y(i));
+    out.normal[k] = Vec2(crack.nx(i), crack.ny(i));
+    out.tip[k] = crack.tip(i) ? 1 : 0;
+    if (std::abs(out.normal[k].norm() - 1.0) > 1e-6) {
+      fail(type, id, "normal " + std::to_string(i) + " has length " + std::to_string(out.normal[k].norm()) +
+                         "; normals must be unit vectors");
+    }
+    if (out.width[k] < 0) {
+      fail(type, id, "width[" + std::to_string(i) + "] = " + std::to_string(out.width[k]) + " m; widths are >= 0");
+    }
+  }
+  return out;
+}
+
+void to_proto(const CrackPressure& crack, protocol::FluidState::Crack* out) {
+  out->Clear();
+  out->set_crack_id(crack.crack_id);
+  out->mutable_ids()->Add(crack.ids.begin(), crack.ids.end());
+  out->mutable_pressure()->Add(crack.pressure.begin(), crack.pressure.end());
+  out->set_front_position(crack.front_position);
+  out->set_inlet_flux(crack.inlet_flux);
+  out->set_fluid_volume(crack.fluid_volume);
+}
+
+CrackPressure from_proto(const protocol::FluidState::Crack& crack) {
+  constexpr std::string_view type = "FluidState";
+  const std::uint32_t id = crack.crack_id();
+  const int n = crack.ids_size();
+  check_length(type, id, "pressure", crack.pressure(), n);
+  check_finite(type, id, "pressure", crack.pressure());
+  check_unique_ids(type, id, crack.ids());
+  for (double v : {crack.front_position(), crack.inlet_flux(), crack.fluid_volume()}) {
+    if (!std::isfinite(v)) fail(type, id, "front_position, inlet_flux and fluid_volume must be finite");
+  }
+  CrackPressure out;
+  out.crack_id = id;
+  out.ids.assign(crack.ids().begin(), crack.ids().end());
+  out.pressure.assign(crack.pressure().begin(), crack.pressure().end());
+  out.front_position = crack.front_position();
+  out.inlet_flux = crack.inlet_flux();
+  out.fluid_volume = crack.fluid_volume();
+  return out;
+}
+
+void to_proto(const SideDiagnostics& d, protocol::Diagnostics* out) {
+  out->set_kinetic_energy(d.kinetic_energy);
+  out->set_crack_length(d.crack_length);
+  out->set_mouth_opening(d.mouth_opening);
+  out->set_crack_face_load(d.crack_face_load);
+  out->set_inlet_pressure(d.inlet_pressure);
+  out->set_injected_volume(d.injected_volume);
+  out->set_fluid_volume(d.fluid_volume);
+  out->set_front_position(d.front_position);
+  out->set_crack_particles(d.crack_particles);
+  out->set_fluid_particles(d.fluid_particles);
+}
+
+SideDiagnostics from_proto(const protocol::Diagnostics& d) {
+  SideDiagnostics out;
+  out.kinetic_energy = d.kinetic_energy();
+  out.crack_length = d.crack_length();
+  out.mouth_opening = d.mouth_opening();
+  out.crack_face_load = d.crack_face_load();
+  out.inlet_pressure = d.inlet_pressure();
+  out.injected_volume = d.injected_volume();
+  out.fluid_volume = d.fluid_volume();
+  out.front_position = d.front_position();
+  out.crack_particles = d.crack_particles();
+  out.fluid_particles = d.fluid_particles();
+  return out;
+}
+
+}  // namespace hfmpm::proto

@@ -1,0 +1,51 @@
+#include "hfmpm/proto/envelope.hpp"
+
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/unknown_field_set.h>
+
+namespace hfmpm::proto {
+
+std::string encode(const protocol::Envelope& envelope) {
+  std::string bytes;
+  if (!envelope.SerializeToString(&bytes)) throw ProtocolError("could not serialize an Envelope");
+  return bytes;
+}
+
+protocol::Envelope decode(const void* data, std::size_t size, std::string_view from) {
+  protocol::Envelope envelope;
+  if (size > static_cast<std::size_t>(INT32_MAX) || !envelope.ParseFromArray(data, static_cast<int>(size))) {
+    throw ProtocolError("malformed message from " + std::string(from) + ": " + std::to_string(size) +
+                        " bytes that do not parse as an hfmpm Envelope");
+  }
+  const auto* reflection = envelope.GetReflection();
+  if (!reflection->GetUnknownFields(envelope).empty()) {
+    throw ProtocolError("malformed message from " + std::string(from) +
+                        ": it carries fields that protocol version " + std::to_string(kProtocolVersion) +
+                        " does not define (a different protocol, or garbage bytes)");
+  }
+  if (envelope.body_case() == protocol::Envelope::BODY_NOT_SET) {
+    throw ProtocolError("malformed message from " + std::string(from) + ": an Envelope with no body (" +
+                        std::to_string(size) + " bytes)");
+  }
+  return envelope;
+}
+
+std::string_view body_name(const protocol::Envelope& envelope) {
+  const auto* field = envelope.GetDescriptor()->FindFieldByNumber(static_cast<int>(envelope.body_case()));
+  return field ? std::string_view(field->name()) : std::string_view("empty");
+}
+
+std::string_view role_name(protocol::Role role) {
+  switch (role) {
+    case protocol::SOLID:
+      return "solid";
+    case protocol::FLUID:
+      return "fluid";
+    case protocol::COUPLER:
+      return "coupler";
+    default:
+      return "unspecified";
+  }
+}
+
+}  // namespace hfmpm::proto
