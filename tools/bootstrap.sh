@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# One entry point for a fresh Debian 12 machine (as root): install what is
+# missing, build (release), then either run the default scene or the tests.
+#   bash tools/bootstrap.sh run    # build + run scenarios/prescribed.scene
+#   bash tools/bootstrap.sh test   # build + ctest (every test)
+#   bash tools/bootstrap.sh build  # build only
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=${1:-run}
+case "$mode" in run|test|build) ;; *) echo "usage: $0 run|test|build" >&2; exit 2 ;; esac
+
+packages=(build-essential cmake pkg-config libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
+          libeigen3-dev libhdf5-dev libgtest-dev libgmock-dev python3)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "bootstrap: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+jobs=$(nproc)
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$jobs"
+
+case "$mode" in
+  run)
+    out=hfmpm-out/prescribed
+    build/release/bin/hfmpm run scenarios/prescribed.scene --out "$out"
+    echo "bootstrap: results are in $out (history.csv, run.json, logs)"
+    ;;
+  test)
+    ctest --preset release -j "$jobs"
+    ;;
+  build) ;;
+esac
