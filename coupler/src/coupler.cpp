@@ -112,7 +112,7 @@ class Coupler {
       summary.error = std::string("coupler: ") + e.what();
     }
     if (!summary.ok) {
-      log_("run failed: " + summary.error);
+      log_.file_only("run failed: " + summary.error);
       stop_sides(true, summary.error);
       manifest_.set("status", "failed");
       manifest_.set("error", summary.error);
@@ -149,6 +149,7 @@ class Coupler {
     manifest_.set("overrides", overrides);
     manifest_.set_number("protocol_version", proto::kProtocolVersion);
     prepared_ = true;
+    history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
 
     router_.set(zmq::sockopt::linger, kLingerMs);
     router_.set(zmq::sockopt::router_mandatory, 1);
@@ -452,7 +453,7 @@ class Coupler {
       send_routed(router_, side.name, envelope);
     } catch (const std::exception&) {
     }
-    throw RunFailure{"rejected " + reason};
+    throw RunFailure{"rejected " + reason + " (handshake, step 0)"};
   }
 
   // ------------------------------------------------------------- stepping
@@ -471,7 +472,7 @@ class Coupler {
   }
 
   void step_loop(RunSummary& summary) {
-    History history(output_dir_ + "/history.csv");
+    History& history = *history_;
     const auto start = Clock::now();
     const double end = scene_.time().end_s();
     const double interval = output_interval(scene_);
@@ -617,6 +618,7 @@ class Coupler {
   Side sides_[2];
   std::string run_id_, output_dir_, control_endpoint_, data_bind_, ipc_dir_;
   Manifest manifest_{""};
+  std::unique_ptr<History> history_;
   bool prepared_ = false;
   Log log_;
   Progress progress_;

@@ -74,6 +74,10 @@ void Log::operator()(const std::string& line) {
   if (file_) file_ << line << std::endl;
 }
 
+void Log::file_only(const std::string& line) {
+  if (file_) file_ << line << std::endl;
+}
+
 Progress::Progress(bool enabled, double end_time)
     : enabled_(enabled), tty_(isatty(STDERR_FILENO) != 0), end_time_(end_time) {}
 

@@ -41,6 +41,7 @@ class Log {
  public:
   void open(const std::string& path);
   void operator()(const std::string& line);
+  void file_only(const std::string& line);
 
  private:
   std::ofstream file_;

@@ -404,7 +404,7 @@ class SideRuntime {
         std::raise(SIGSTOP);
         break;
       case Fault::Kind::Garbage: {
-        const std::string garbage = "\xff\x01garbage\x00\x7f not an envelope";
+        const std::string garbage("\xff\x01garbage\x00\x7f not an envelope", 28);
         (void)control_.send(zmq::buffer(garbage), zmq::send_flags::none);
         if (data_) (void)data_->send(zmq::buffer(garbage), zmq::send_flags::none);
         break;

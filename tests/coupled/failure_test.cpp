@@ -1,0 +1,238 @@
+// Failures of a coupled run: a side that exits, crashes, is killed, hangs,
+// freezes, speaks another protocol version or sends garbage; a dead coupler.
+// Each must be detected within a bounded time, name the failed side and the
+// step, leave history.csv readable, and leave no process running.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <zmq.hpp>
+
+#include "coupled_support.hpp"
+
+namespace hfmpm::test {
+namespace {
+
+// Fast liveness settings so each failure is found in about a second.
+const std::vector<std::string> kFastLiveness{"--set", "coupling.heartbeat_interval_s=0.1",
+                                             "--set", "coupling.heartbeat_timeout_s=1",
+                                             "--set", "coupling.step_timeout_s=2"};
+
+// Rows in a run's history.csv so far (0 before the coupler has created it).
+std::size_t history_rows(const std::string& out) {
+  try {
+    return read_csv(out + "/history.csv").rows.size();
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
+struct FailedRun {
+  RunResult result;
+  std::string out;
+  double wall_s = 0;
+};
+
+FailedRun run_with(const std::string& side, const std::vector<std::string>& side_args, double end_s = 0.2) {
+  FailedRun failed;
+  failed.out = scratch_dir("fail");
+  std::string list;
+  for (const auto& a : side_args) list += (list.empty() ? "\"" : ", \"") + a + "\"";
+  std::vector<std::string> extra = kFastLiveness;
+  extra.insert(extra.end(), {"--set", "coupling." + side + "_args=[" + list + "]"});
+  const auto start = std::chrono::steady_clock::now();
+  failed.result = run_scene(prescribed_scene(end_s), failed.out, extra, 60);
+  failed.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return failed;
+}
+
+// What every failure must leave behind.
+void expect_clean_failure(const FailedRun& run, const std::string& side, const std::string& detail,
+                          std::size_t min_rows = 1) {
+  EXPECT_FALSE(run.result.timed_out);
+  EXPECT_EQ(run.result.exit_code, 1) << run.result.err;
+  EXPECT_NE(run.result.err.find("the " + side + " side"), std::string::npos) << run.result.err;
+  EXPECT_NE(run.result.err.find("step"), std::string::npos) << run.result.err;
+  EXPECT_NE(run.result.err.find(detail), std::string::npos) << run.result.err;
+  const Csv history = read_csv(run.out + "/history.csv");  // throws if unreadable
+  EXPECT_GE(history.rows.size(), min_rows);
+  const std::string manifest = read_file(run.out + "/run.json");
+  EXPECT_EQ(json_string(manifest, "status"), "failed");
+  EXPECT_NE(json_string(manifest, "error").find(side), std::string::npos);
+  for (const char* name : {"solid_pid", "fluid_pid"}) {
+    const auto pid = static_cast<pid_t>(json_number(manifest, name));
+    if (pid > 0) {
+      EXPECT_FALSE(pid_alive(pid)) << name << " " << pid << " still running";
+    }
+  }
+}
+
+TEST(Failure, FluidExitsAbruptly) {
+  const auto run = run_with("fluid", {"--fault", "exit@50"});
+  expect_clean_failure(run, "fluid", "exited with status 7");
+  EXPECT_LT(run.wall_s, 10);
+}
+
+TEST(Failure, SolidCrashes) {
+  const auto run = run_with("solid", {"--fault", "crash@50"});
+  expect_clean_failure(run, "solid", "SIGABRT");
+}
+
+TEST(Failure, FluidHangsWhileTheSolidWaitsForIt) {
+  const auto run = run_with("fluid", {"--fault", "hang@50"});
+  expect_clean_failure(run, "fluid", "stopped making progress");
+  // Both sides are silent on the data plane, but only the fluid is to blame.
+  EXPECT_EQ(run.result.err.find("solid and fluid"), std::string::npos) << run.result.err;
+  EXPECT_LT(run.wall_s, 15);
+}
+
+TEST(Failure, SolidFreezes) {
+  const auto run = run_with("solid", {"--fault", "freeze@50"});
+  expect_clean_failure(run, "solid", "stopped answering");
+  EXPECT_LT(run.wall_s, 10);
+}
+
+TEST(Failure, FluidWithAnotherProtocolVersionIsRejected) {
+  const auto run = run_with("fluid", {"--protocol-version", "2"});
+  // Refused at the handshake: history.csv has its header and no row yet.
+  expect_clean_failure(run, "fluid", "speaks protocol version 2; this coupler speaks version 1", 0);
+}
+
+TEST(Failure, GarbageFromASideIsRejected) {
+  const auto run = run_with("fluid", {"--fault", "garbage@30"});
+  expect_clean_failure(run, "fluid", "malformed message from the fluid side");
+}
+
+TEST(Failure, NonFiniteDataOnTheDataPlaneIsRejected) {
+  const auto run = run_with("solid", {"--fault", "nan@30"});
+  // The fluid refuses the frame and says why; the coupler names it.
+  expect_clean_failure(run, "fluid", "'width[0]' is not finite");
+}
+
+void kill_side_mid_run(const std::string& side) {
+  const auto out = scratch_dir("kill");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  std::vector<std::string> argv{bin("hfmpm"), "run", scene, "--out", out, "--quiet"};
+  argv.insert(argv.end(), kFastLiveness.begin(), kFastLiveness.end());
+  Process coupler(argv);
+  pid_t pid = 0;
+  for (int i = 0; i < 500 && (pid == 0 || history_rows(out) < 3); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    pid = static_cast<pid_t>(json_number(read_file(out + "/run.json"), side + "_pid"));
+  }
+  ASSERT_GT(pid, 0);
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  ASSERT_TRUE(coupler.wait(10)) << "coupler did not notice the killed " << side;
+  FailedRun run{{coupler.exit_code(), coupler.term_signal(), false, coupler.out(), coupler.err()}, out, 0};
+  expect_clean_failure(run, side, "killed by signal 9 (SIGKILL)");
+}
+
+TEST(Failure, SolidKilledWithSignal9) { kill_side_mid_run("solid"); }
+TEST(Failure, FluidKilledWithSignal9) { kill_side_mid_run("fluid"); }
+
+TEST(Failure, SidesDieWithAKilledCoupler) {
+  const auto out = scratch_dir("coupler-dies");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  Process coupler({bin("hfmpm"), "run", scene, "--out", out, "--quiet"});
+  pid_t solid = 0, fluid = 0;
+  for (int i = 0; i < 500 && (solid == 0 || fluid == 0); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::string manifest = read_file(out + "/run.json");
+    solid = static_cast<pid_t>(json_number(manifest, "solid_pid"));
+    fluid = static_cast<pid_t>(json_number(manifest, "fluid_pid"));
+  }
+  ASSERT_GT(solid, 0);
+  kill(coupler.pid(), SIGKILL);
+  coupler.wait(5);
+  for (int i = 0; i < 200 && (pid_alive(solid) || pid_alive(fluid)); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_FALSE(pid_alive(solid));
+  EXPECT_FALSE(pid_alive(fluid));
+  EXPECT_GE(read_csv(out + "/history.csv").rows.size(), 1u);
+}
+
+// Sides started by hand (not children of the coupler) notice its silence.
+TEST(Failure, HandStartedSidesExitWhenTheCouplerGoesSilent) {
+  const auto out = scratch_dir("silent");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  std::vector<std::string> argv{bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet"};
+  argv.insert(argv.end(), kFastLiveness.begin(), kFastLiveness.end());
+  Process coupler(argv);
+  const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
+  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--advertise-host", "127.0.0.1"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint});
+  for (int i = 0; i < 500 && history_rows(out) < 3; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  kill(coupler.pid(), SIGSTOP);  // alive but silent: no heartbeats
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(solid.wait(5));
+  EXPECT_TRUE(fluid.wait(5));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 4.0);
+  EXPECT_EQ(solid.exit_code(), 4) << solid.err();  // kSideCouplerLost
+  EXPECT_EQ(fluid.exit_code(), 4) << fluid.err();
+  EXPECT_NE(solid.err().find("nothing from the coupler"), std::string::npos) << solid.err();
+  kill(coupler.pid(), SIGKILL);
+  kill(coupler.pid(), SIGCONT);
+}
+
+TEST(Failure, NoSideJoinsWithinTheJoinTimeout) {
+  const auto out = scratch_dir("nojoin");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene());
+  const auto result = run({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet",
+                           "--set", "coupling.join_timeout_s=1"},
+                          20);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("within coupling.join_timeout_s"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("solid, fluid"), std::string::npos) << result.err;
+}
+
+// Bytes that are not ZMTP on the coupler's tcp port, and a ZeroMQ peer that is
+// neither side sending garbage: both are refused and the run goes on unchanged.
+TEST(Failure, StrangersOnTheControlPortAreIgnored) {
+  const auto reference = scratch_dir("strangers-ref");
+  ASSERT_EQ(run_scene(prescribed_scene(), reference, {}).exit_code, 0);
+
+  const auto out = scratch_dir("strangers");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene());
+  Process coupler({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet"});
+  const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
+  ASSERT_FALSE(endpoint.empty());
+  const int port = std::stoi(endpoint.substr(endpoint.rfind(':') + 1));
+
+  const int raw = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(connect(raw, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+  const std::string junk(4096, '\xa5');
+  EXPECT_GT(write(raw, junk.data(), junk.size()), 0);
+
+  zmq::context_t context;
+  zmq::socket_t stranger(context, zmq::socket_type::dealer);
+  stranger.set(zmq::sockopt::linger, 0);
+  stranger.set(zmq::sockopt::routing_id, "intruder");
+  stranger.connect(endpoint);
+  stranger.send(zmq::str_buffer("\x08\xff\xff garbage"), zmq::send_flags::none);
+
+  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--out", out, "--advertise-host", "127.0.0.1"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", out});
+  ASSERT_TRUE(coupler.wait(60));
+  close(raw);
+  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
+  EXPECT_NE(read_file(out + "/coupler.log").find("ignored a message from an unknown peer 'intruder'"),
+            std::string::npos);
+  expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
+}
+
+}  // namespace
+}  // namespace hfmpm::test
