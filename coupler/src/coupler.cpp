@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <limits>
 #include <optional>
 #include <random>
@@ -137,7 +138,7 @@ class Coupler {
   void prepare() {
     fs::create_directories(options_.output_dir);
     output_dir_ = fs::absolute(options_.output_dir).string();
-    log_.open(output_dir_ + "/coupler.log");
+    log_.open(output_dir_ + "/coupler.log", options_.progress);
     manifest_ = Manifest(output_dir_ + "/run.json");
     run_id_ = random_id();
     manifest_.set("run_id", run_id_);
@@ -192,7 +193,11 @@ class Coupler {
     if (options_.launch) {
       launch_sides();
     } else {
-      log_("waiting for sides at " + control_endpoint_ + " (start each with --connect " + control_endpoint_ + ")");
+      // Printed even when quiet: the person starting the sides needs the endpoint.
+      const std::string line = "waiting for sides at " + control_endpoint_ + " (start each with --connect " +
+                               control_endpoint_ + ")";
+      std::cerr << "hfmpm: " << line << std::endl;
+      log_.file_only(line);
     }
     manifest_.save();
   }

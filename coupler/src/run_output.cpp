@@ -70,7 +70,7 @@ void Manifest::save() const {
 void Log::open(const std::string& path) { file_.open(path, std::ios::app); }
 
 void Log::operator()(const std::string& line) {
-  std::cerr << "hfmpm: " << line << "\n";
+  if (echo_) std::cerr << "hfmpm: " << line << "\n";
   if (file_) file_ << line << std::endl;
 }
 

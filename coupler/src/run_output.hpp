@@ -39,12 +39,17 @@ class Manifest {
 // Log lines to stderr and to the run's coupler.log.
 class Log {
  public:
+  void open(const std::string& path, bool echo) {
+    open(path);
+    echo_ = echo;
+  }
   void open(const std::string& path);
   void operator()(const std::string& line);
   void file_only(const std::string& line);
 
  private:
   std::ofstream file_;
+  bool echo_ = true;
 };
 
 class Progress {
