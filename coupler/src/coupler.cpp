@@ -377,7 +377,10 @@ class Coupler {
         if (Clock::now() > deadline) {
           std::string missing;
           for (auto& side : sides_) {
-            if (side.expected && !(side.joined && side.ready)) missing += (missing.empty() ? "" : ", ") + side.name;
+            if (side.expected && !(side.joined && side.ready)) {
+              if (!missing.empty()) missing += ", ";
+              missing += side.name;
+            }
           }
           throw RunFailure{"no " + what + " within coupling.join_timeout_s = " +
                            std::to_string(scene_.coupling().join_timeout_s()) + " s (waiting for: " + missing + ")"};
@@ -482,7 +485,7 @@ class Coupler {
     const double end = scene_.time().end_s();
     const double interval = output_interval(scene_);
     const std::uint32_t k = sides_[1].expected ? scene_.coupling().exchange_interval() : 1;
-    const std::uint64_t block = (scene_.coupling().control_interval() + k - 1) / k * k;
+    const std::uint64_t block = (std::uint64_t{scene_.coupling().control_interval()} + k - 1) / k * k;
     double dt = next_dt();
     history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
     std::uint64_t frame = 1;
@@ -495,7 +498,8 @@ class Coupler {
         const auto steps = static_cast<std::uint64_t>(std::max(1.0, n));
         return (steps + k - 1) / k * k;
       };
-      const std::uint64_t n = std::min(block, steps_to(std::min(next_output, end)));
+      const std::uint64_t to_max = (scene_.time().max_steps() - step_ + k - 1) / k * k;
+      const std::uint64_t n = std::min({block, steps_to(std::min(next_output, end)), to_max});
       const double t_end = t_ + static_cast<double>(n) * dt;
       const bool output = t_end >= next_output * (1 - 1e-12) || t_end >= end * (1 - 1e-12);
 

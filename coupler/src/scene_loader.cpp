@@ -30,8 +30,13 @@ std::string field_names(const pb::Descriptor* type) {
 // allowed keys when a key is unknown.
 class Collector : public pb::io::ErrorCollector {
  public:
-  explicit Collector(std::string name) : name_(std::move(name)) {}
+  explicit Collector(std::string name, std::string source = "") : name_(std::move(name)), source_(std::move(source)) {}
   void AddError(int line, pb::io::ColumnNumber column, const std::string& message) override {
+    // Protobuf places an unknown enum value at the token after it, which may
+    // be on the next line: point at the last line up to there that holds it.
+    static const std::regex bad_enum(R"re(Unknown enumeration value of "([^"]*)")re");
+    std::smatch e;
+    if (std::regex_search(message, e, bad_enum)) line = line_of_token_before(e[1].str(), line);
     std::string text = name_ + ":" + std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message;
     static const std::regex unknown(R"re(Message type "([A-Za-z0-9_.]+)" has no field named "([^"]*)")re");
     std::smatch m;
@@ -47,7 +52,17 @@ class Collector : public pb::io::ErrorCollector {
   std::vector<std::string> errors_;
 
  private:
+  int line_of_token_before(const std::string& token, int line) const {
+    std::stringstream lines(source_);
+    std::string text;
+    int found = line;
+    for (int i = 0; i <= line && std::getline(lines, text); ++i) {
+      if (text.find(token) != std::string::npos) found = i;
+    }
+    return found;
+  }
   std::string name_;
+  std::string source_;
 };
 
 // Line (1-based) where the key path was written, or 0 if it was not written.
@@ -108,6 +123,7 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
   }
   const std::string key = assignment.substr(0, equals);
   std::string value = assignment.substr(equals + 1);
+  if (value.empty()) throw SceneError({"--set " + key + "=: no value given; write --set " + key + "=VALUE"});
   pb::Message* message = &scene;
   std::stringstream parts(key);
   std::string part, path;
@@ -154,7 +170,7 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
 scene::Scene parse_scene(const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
   scene::Scene scene;
   pb::TextFormat::Parser parser;
-  Collector collector(name);
+  Collector collector(name, text);
   pb::TextFormat::ParseInfoTree tree;
   parser.RecordErrorsTo(&collector);
   parser.WriteLocationsTo(&tree);

@@ -404,7 +404,8 @@ class SideRuntime {
         std::raise(SIGSTOP);
         break;
       case Fault::Kind::Garbage: {
-        const std::string garbage("\xff\x01garbage\x00\x7f not an envelope", 28);
+        static constexpr char kGarbage[] = "\xff\x01garbage\x00\x7f not an envelope";
+        const std::string garbage(kGarbage, sizeof(kGarbage) - 1);
         (void)control_.send(zmq::buffer(garbage), zmq::send_flags::none);
         if (data_) (void)data_->send(zmq::buffer(garbage), zmq::send_flags::none);
         break;

@@ -3,7 +3,31 @@
 #include <google/protobuf/descriptor.h>
 #include <google/protobuf/unknown_field_set.h>
 
+#include <vector>
+
 namespace hfmpm::proto {
+namespace {
+
+// True if `message` or any message set inside it carries unknown fields.
+bool has_unknown_fields(const google::protobuf::Message& message) {
+  const auto* reflection = message.GetReflection();
+  if (!reflection->GetUnknownFields(message).empty()) return true;
+  std::vector<const google::protobuf::FieldDescriptor*> fields;
+  reflection->ListFields(message, &fields);
+  for (const auto* field : fields) {
+    if (field->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE) continue;
+    if (field->is_repeated()) {
+      for (int i = 0; i < reflection->FieldSize(message, field); ++i) {
+        if (has_unknown_fields(reflection->GetRepeatedMessage(message, field, i))) return true;
+      }
+    } else if (has_unknown_fields(reflection->GetMessage(message, field))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
 
 std::string encode(const protocol::Envelope& envelope) {
   std::string bytes;
@@ -17,8 +41,7 @@ protocol::Envelope decode(const void* data, std::size_t size, std::string_view f
     throw ProtocolError("malformed message from " + std::string(from) + ": " + std::to_string(size) +
                         " bytes that do not parse as an hfmpm Envelope");
   }
-  const auto* reflection = envelope.GetReflection();
-  if (!reflection->GetUnknownFields(envelope).empty()) {
+  if (has_unknown_fields(envelope)) {
     throw ProtocolError("malformed message from " + std::string(from) +
                         ": it carries fields that protocol version " + std::to_string(kProtocolVersion) +
                         " does not define (a different protocol, or garbage bytes)");

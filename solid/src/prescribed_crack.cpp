@@ -62,9 +62,9 @@ void PrescribedCrack::set_pressure(const CrackPressure& pressure) {
                                   " has particle " + std::to_string(crack_.ids[i]) +
                                   "; pressure ids must follow the crack's ids in order");
     }
-    pressure_[i] = pressure.pressure[i];
   }
-  for (std::size_t i = pressure.size(); i < crack_.size(); ++i) pressure_[i] = 0.0;
+  // All ids checked: nothing is half-applied when they do not match.
+  for (std::size_t i = 0; i < crack_.size(); ++i) pressure_[i] = i < pressure.size() ? pressure.pressure[i] : 0.0;
 }
 
 SideDiagnostics PrescribedCrack::diagnostics() const {
