@@ -75,7 +75,7 @@ bool loopback(const std::string& host) {
 class Coupler {
  public:
   Coupler(const scene::Scene& scene, const RunOptions& options)
-      : scene_(scene), options_(options), router_(context_, zmq::socket_type::router),
+      : scene_(scene), options_(options), router_(*context_, zmq::socket_type::router),
         progress_(options.progress, scene.time().end_s()) {
     sides_[0].role = protocol::SOLID;
     sides_[0].name = "solid";
@@ -91,6 +91,9 @@ class Coupler {
     for (auto& side : sides_) {
       if (side.thread.joinable()) side.thread.join();
     }
+    // Terminating a context waits for every socket to close; a detached side
+    // thread may never close its own, so its context is left to process exit.
+    if (leak_context_) (void)context_.release();
     if (!ipc_dir_.empty()) {
       std::error_code ignored;
       fs::remove_all(ipc_dir_, ignored);
@@ -222,7 +225,7 @@ class Coupler {
         side_options.role = side.role;
         side_options.control_endpoint = control_endpoint_;
         side_options.implementation = std::string("in-process ") + side.name;
-        side_options.context = &context_;
+        side_options.context = context_.get();
         side.thread = std::thread([model, side_options, exit = side.thread_exit] { *exit = run_side(*model, side_options); });
         manifest_.set(side.name + "_program", "in-process thread");
         continue;
@@ -593,7 +596,7 @@ class Coupler {
     for (auto& side : sides_) {
       if (!side.expected || side.stopping) continue;
       side.stopping = true;
-      if (side.joined) {
+      if (side.joined || side.thread_exit) {  // an in-process side may be connected before its Hello is read
         try {
           send_routed(router_, side.name, envelope);
         } catch (const std::exception&) {
@@ -608,27 +611,33 @@ class Coupler {
         }
       }
       if (side.thread.joinable()) {
-        if (!side.joined && side.thread_exit && side.thread_exit->load() < 0) {
-          // A thread that never joined waits for the coupler's answer; tell it to go.
-          try {
-            send_routed(router_, side.name, envelope);
-          } catch (const std::exception&) {
-          }
+        // A thread cannot be killed: wait a bounded time, then leave it behind
+        // (it ends with the process) rather than hang the coupler.
+        const auto deadline = Clock::now() + std::chrono::seconds(error ? 5 : 60);
+        while (side.thread_exit->load() < 0 && Clock::now() < deadline) {
+          std::this_thread::sleep_for(milliseconds(2));
         }
-        side.thread.join();
+        if (side.thread_exit->load() >= 0) {
+          side.thread.join();
+        } else {
+          log_("the in-process " + side.name + " side did not stop; leaving it to end with the process");
+          side.thread.detach();
+          leak_context_ = true;
+        }
       }
     }
   }
 
   scene::Scene scene_;
   RunOptions options_;
-  zmq::context_t context_{1};
+  std::unique_ptr<zmq::context_t> context_ = std::make_unique<zmq::context_t>(1);
   zmq::socket_t router_;
   Side sides_[2];
   std::string run_id_, output_dir_, control_endpoint_, data_bind_, ipc_dir_;
   Manifest manifest_{""};
   std::unique_ptr<History> history_;
   bool prepared_ = false;
+  bool leak_context_ = false;
   Log log_;
   Progress progress_;
   microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};
