@@ -112,6 +112,10 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     if (bind.empty()) throw UsageError("'hfmpm coupler' needs --bind ENDPOINT (e.g. tcp://0.0.0.0:5555)");
     options.launch = false;
     options.bind_endpoint = bind;
+    if (!options.solid_program.empty() || !options.fluid_program.empty()) {
+      throw UsageError("--solid-program and --fluid-program are for 'hfmpm run'; with 'hfmpm coupler' you start "
+                       "the sides yourself");
+    }
   } else if (!bind.empty()) {
     throw UsageError("--bind is for 'hfmpm coupler'; 'hfmpm run' chooses its own endpoints");
   }

@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <functional>
+#include <iomanip>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -68,6 +70,11 @@ std::string random_id() {
   return out.str().substr(0, 12);
 }
 
+std::string host_name() {
+  char buffer[256] = {};
+  return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
+}
+
 bool loopback(const std::string& host) {
   return host == "localhost" || host.rfind("127.", 0) == 0 || host == "::1";
 }
@@ -109,7 +116,7 @@ class Coupler {
       step_loop(summary);
       stop_sides(false, "end of run");
       summary.ok = true;
-      manifest_.set("status", "completed");
+      manifest_.set("status", stopped_at_max_steps_ ? "stopped at time.max_steps" : "completed");
     } catch (const RunFailure& failure) {
       summary.error = failure.message;
     } catch (const std::exception& e) {
@@ -197,8 +204,10 @@ class Coupler {
       launch_sides();
     } else {
       // Printed even when quiet: the person starting the sides needs the endpoint.
+      std::string reachable = control_endpoint_;
+      if (tcp_host(reachable) == "0.0.0.0") reachable = advertise(reachable, host_name());
       const std::string line = "waiting for sides at " + control_endpoint_ + " (start each with --connect " +
-                               control_endpoint_ + ")";
+                               reachable + ")";
       std::cerr << "hfmpm: " << line << std::endl;
       log_.file_only(line);
     }
@@ -331,6 +340,7 @@ class Coupler {
       if (side.joined && now - side.last_sent > heartbeat_interval_) {
         protocol::Envelope beat;
         beat.mutable_heartbeat()->set_role(protocol::COUPLER);
+        beat.mutable_heartbeat()->set_sequence(++heartbeats_sent_);
         beat.mutable_heartbeat()->set_step(step_);
         send_to(side, beat);
       }
@@ -368,42 +378,45 @@ class Coupler {
 
   // ------------------------------------------------------------ handshake
   void handshake() {
-    const auto deadline = Clock::now() + microseconds(static_cast<std::int64_t>(scene_.coupling().join_timeout_s() * 1e6));
-    auto all = [&](auto predicate) {
-      for (auto& side : sides_) {
-        if (side.expected && !predicate(side)) return false;
-      }
-      return true;
-    };
-    auto wait_until = [&](auto done, const std::string& what) {
-      while (!done()) {
+    using Pending = std::function<bool(const Side&)>;
+    // Waits until no expected side is `pending`; the error lists those that still are.
+    auto wait_until = [&](const Pending& pending, const std::string& what, const std::string& timeout_key,
+                          double timeout_s) {
+      const auto deadline = Clock::now() + microseconds(static_cast<std::int64_t>(timeout_s * 1e6));
+      while (true) {
+        std::string missing;
+        for (const auto& side : sides_) {
+          if (!side.expected || !pending(side)) continue;
+          if (!missing.empty()) missing += ", ";
+          missing += side.name;
+        }
+        if (missing.empty()) return;
         if (Clock::now() > deadline) {
-          std::string missing;
-          for (auto& side : sides_) {
-            if (side.expected && !(side.joined && side.ready)) {
-              if (!missing.empty()) missing += ", ";
-              missing += side.name;
-            }
-          }
-          throw RunFailure{"no " + what + " within coupling.join_timeout_s = " +
-                           std::to_string(scene_.coupling().join_timeout_s()) + " s (waiting for: " + missing + ")"};
+          std::ostringstream out;
+          out << "no " << what << " within " << timeout_key << " = " << timeout_s << " s (still waiting for: " << missing
+              << ")";
+          throw RunFailure{out.str()};
         }
         auto message = pump(milliseconds(20));
         if (message) on_handshake_message(*message->first, message->second);
       }
     };
-    wait_until([&] { return all([](Side& s) { return s.joined; }); }, "Hello from every side");
+    const auto& coupling = scene_.coupling();
+    wait_until([](const Side& s) { return !s.joined; }, "Hello", "coupling.join_timeout_s", coupling.join_timeout_s());
 
+    // Setup (building each model) happens between Welcome and Ready; heartbeats
+    // prove the sides alive meanwhile, so this limit can be generous.
     Side& solid = sides_[0];
     Side& fluid = sides_[1];
     protocol::Envelope welcome = welcome_for(fluid.expected ? protocol::DataPlane::BIND : protocol::DataPlane::NONE,
                                              data_bind_);
     send_to(solid, welcome);
     if (fluid.expected) {
-      wait_until([&] { return !solid.data_endpoint.empty(); }, "Listening from the solid side");
+      wait_until([](const Side& s) { return s.role == protocol::SOLID && s.data_endpoint.empty(); },
+                 "Listening from the solid side", "coupling.setup_timeout_s", coupling.setup_timeout_s());
       send_to(fluid, welcome_for(protocol::DataPlane::CONNECT, solid.data_endpoint));
     }
-    wait_until([&] { return all([](Side& s) { return s.ready; }); }, "Ready from every side");
+    wait_until([](const Side& s) { return !s.ready; }, "Ready", "coupling.setup_timeout_s", coupling.setup_timeout_s());
     manifest_.set("status", "running");
     manifest_.save();
   }
@@ -494,17 +507,21 @@ class Coupler {
     std::uint64_t frame = 1;
     double next_output = interval;
     double mean_command_s = 0;
-    while (t_ < end * (1 - 1e-12) && step_ < scene_.time().max_steps()) {
+    const std::uint64_t max_steps = scene_.time().max_steps();
+    while (t_ < end * (1 - 1e-12)) {
       // Steps to reach the next output time (and the end), rounded up to whole exchange windows.
       auto steps_to = [&](double target) {
         const double n = std::ceil((target - t_) / dt * (1 - 1e-12));
         const auto steps = static_cast<std::uint64_t>(std::max(1.0, n));
         return (steps + k - 1) / k * k;
       };
-      const std::uint64_t to_max = (scene_.time().max_steps() - step_ + k - 1) / k * k;
+      // time.max_steps, in whole exchange windows (a command never splits one).
+      const std::uint64_t to_max = (max_steps - step_) / k * k;
+      if (to_max == 0) break;
       const std::uint64_t n = std::min({block, steps_to(std::min(next_output, end)), to_max});
       const double t_end = t_ + static_cast<double>(n) * dt;
-      const bool output = t_end >= next_output * (1 - 1e-12) || t_end >= end * (1 - 1e-12);
+      const bool last_allowed = n == to_max && max_steps - step_ - n < k;
+      const bool output = t_end >= next_output * (1 - 1e-12) || t_end >= end * (1 - 1e-12) || last_allowed;
 
       protocol::Envelope envelope;
       auto* command = envelope.mutable_step_command();
@@ -536,17 +553,19 @@ class Coupler {
         side.compute_s += side.report->compute_s();
         side.exchange_s += side.report->exchange_s();
       }
-      dt = t_ < end * (1 - 1e-12) ? next_dt() : dt;
-      if (output) {
+      if (output) {  // dt_s: the step that led to this row
         history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
         ++frame;
         while (next_output <= t_ * (1 + 1e-12)) next_output += interval;
       }
+      if (t_ < end * (1 - 1e-12)) dt = next_dt();
       progress_.update(t_, step_, seconds_since(start));
     }
     summary.stepping_wall_s = seconds_since(start);
-    if (step_ >= scene_.time().max_steps() && t_ < end * (1 - 1e-12)) {
-      log_("stopped at time.max_steps = " + std::to_string(scene_.time().max_steps()) + " before time.end_s");
+    if (t_ < end * (1 - 1e-12)) {
+      stopped_at_max_steps_ = true;
+      log_("stopped at step " + std::to_string(step_) + " (time.max_steps = " + std::to_string(max_steps) +
+           ", in whole exchange windows) before time.end_s");
     }
   }
 
@@ -567,7 +586,7 @@ class Coupler {
       const auto& report = envelope.step_report();
       if (report.step() != step || report.t() != t) {
         std::ostringstream out;
-        out << "the " << side->name << " side reports step " << report.step() << " at t = " << report.t()
+        out << std::setprecision(17) << "the " << side->name << " side reports step " << report.step() << " at t = " << report.t()
             << " s, but step " << step << " at t = " << t << " s was commanded";
         throw RunFailure{out.str()};
       }
@@ -605,8 +624,9 @@ class Coupler {
     }
     for (auto& side : sides_) {
       if (side.process) {
-        if (!side.process->wait_for(error ? 2.0 : 10.0)) {
-          log_("the " + side.name + " side did not exit after Shutdown; terminating it");
+        if (!side.process->wait_for(!side.joined ? 0.5 : error ? 2.0 : 10.0)) {
+          log_(side.joined ? "the " + side.name + " side did not exit after Shutdown; terminating it"
+                           : "the " + side.name + " side never joined; terminating it");
           side.process->stop(1.0);
         }
       }
@@ -638,11 +658,13 @@ class Coupler {
   std::unique_ptr<History> history_;
   bool prepared_ = false;
   bool leak_context_ = false;
+  bool stopped_at_max_steps_ = false;
   Log log_;
   Progress progress_;
   microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};
   Clock::time_point start_ = Clock::now(), last_housekeeping_{};
   std::uint64_t step_ = 0;
+  std::uint64_t heartbeats_sent_ = 0;
   double t_ = 0;
 };
 

@@ -67,7 +67,7 @@ void Manifest::save() const {
   std::rename(tmp.c_str(), path_.c_str());
 }
 
-void Log::open(const std::string& path) { file_.open(path, std::ios::app); }
+void Log::open(const std::string& path) { file_.open(path, std::ios::trunc); }
 
 void Log::operator()(const std::string& line) {
   if (echo_) std::cerr << "hfmpm: " << line << "\n";

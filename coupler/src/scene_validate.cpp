@@ -122,6 +122,11 @@ void check_coupling(Checker& c, const scene::Coupling& k) {
   c.range("coupling.heartbeat_interval_s", k.heartbeat_interval_s(), 0.01, 60, false, "s");
   c.range("coupling.heartbeat_timeout_s", k.heartbeat_timeout_s(), 2 * k.heartbeat_interval_s(), 3600, true,
           "s, more than twice coupling.heartbeat_interval_s");
+  if (k.heartbeat_timeout_s() < 0.5) {
+    c.bad("coupling.heartbeat_timeout_s", text(k.heartbeat_timeout_s()),
+          "at least 0.5 s (sides send heartbeats every 0.1 s before they know the scene)");
+  }
+  c.range("coupling.setup_timeout_s", k.setup_timeout_s(), 0, 86400, true, "s");
   c.range("coupling.step_timeout_s", k.step_timeout_s(), 0, 86400, true, "s");
   c.range("coupling.join_timeout_s", k.join_timeout_s(), 0, 86400, true, "s");
   if (k.tcp_host().empty()) c.bad("coupling.tcp_host", "\"\"", "a host name or address to bind, e.g. 127.0.0.1");

@@ -39,12 +39,16 @@ std::string host_name() {
   return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
 }
 
-// Sends Heartbeat on its own socket at a fixed interval until stopped.
+// Heartbeat interval before the scene's is known (between Hello and Welcome).
+// The scene validator keeps heartbeat_timeout_s >= 0.5 s, well above it.
+constexpr double kFirstHeartbeatIntervalS = 0.1;
+
+// Sends Heartbeat on its own socket at an interval until stopped.
 class HeartbeatThread {
  public:
-  HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role, double interval_s,
+  HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role,
                   const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting)
-      : thread_([this, &context, endpoint, role, interval_s, &step, &waiting] {
+      : thread_([this, &context, endpoint, role, &step, &waiting] {
           zmq::socket_t socket(context, zmq::socket_type::dealer);
           socket.set(zmq::sockopt::linger, 0);
           socket.set(zmq::sockopt::routing_id, std::string(proto::role_name(role)) + ".hb");
@@ -59,7 +63,7 @@ class HeartbeatThread {
             beat->set_step(step.load());
             beat->set_waiting_for_peer(waiting.load());
             (void)socket.send(zmq::buffer(proto::encode(envelope)), zmq::send_flags::dontwait);
-            wake_.wait_for(lock, to_us(interval_s), [this] { return stop_; });
+            wake_.wait_for(lock, to_us(interval_s_), [this] { return stop_; });
           }
         }) {}
   ~HeartbeatThread() {
@@ -72,8 +76,10 @@ class HeartbeatThread {
   }
   HeartbeatThread(const HeartbeatThread&) = delete;
   HeartbeatThread& operator=(const HeartbeatThread&) = delete;
+  void set_interval(double seconds) { interval_s_ = seconds; }
 
  private:
+  std::atomic<double> interval_s_{kFirstHeartbeatIntervalS};
   std::mutex mutex_;
   std::condition_variable wake_;
   bool stop_ = false;
@@ -102,9 +108,9 @@ class SideRuntime {
       loop();
       model_.finish();
       return kSideOk;
-    } catch (const ShutdownRequested&) {
+    } catch (const ShutdownRequested& shutdown) {
       model_.finish();
-      return kSideOk;
+      return shutdown.error ? kSideStoppedOnError : kSideOk;
     } catch (const CouplerLost& lost) {
       std::cerr << role_ << ": " << lost.what << "; exiting\n";
       return kSideCouplerLost;
@@ -147,6 +153,9 @@ class SideRuntime {
     hello->set_host(host_name());
     hello->set_pid(getpid());
     send(control_, hello_envelope);
+    // From now on the coupler hears from this side even during a long setup.
+    heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role,
+                                                   heartbeat_step_, waiting_for_peer_);
 
     const auto deadline = Clock::now() + to_us(options_.welcome_timeout_s);
     while (true) {
@@ -164,6 +173,11 @@ class SideRuntime {
       if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
       if (!envelope->has_welcome()) unexpected(*envelope, "Welcome or Reject");
       welcome_ = envelope->welcome();
+      if (welcome_.protocol_version() != options_.protocol_version) {
+        throw proto::ProtocolError("the coupler's Welcome says protocol version " +
+                                   std::to_string(welcome_.protocol_version()) + "; this side speaks version " +
+                                   std::to_string(options_.protocol_version));
+      }
       return;
     }
   }
@@ -180,18 +194,22 @@ class SideRuntime {
     exchange_interval_ = std::max(1u, scene.coupling().exchange_interval());
     gauss_seidel_ = scene.coupling().scheme() == scene::Coupling::GAUSS_SEIDEL;
 
-    std::string output_dir = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
-    if (output_dir.empty()) output_dir = ".";
+    const std::string& chosen = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
+    const std::string output_dir = chosen.empty() ? std::string(".") : chosen;
     std::filesystem::create_directories(output_dir);
     model_.setup(scene, output_dir);
     if (scene.output().exchange_log()) log_ = std::make_unique<ExchangeLog>(output_dir, role_);
 
-    heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role,
-                                                   scene.coupling().heartbeat_interval_s(), heartbeat_step_,
-                                                   waiting_for_peer_);
+    heartbeat_->set_interval(scene.coupling().heartbeat_interval_s());
     last_from_coupler_ = Clock::now();
 
     const auto mode = welcome_.data_plane().mode();
+    if (mode != protocol::DataPlane::NONE && mode != protocol::DataPlane::BIND && mode != protocol::DataPlane::CONNECT) {
+      throw proto::ProtocolError("Welcome.data_plane.mode = " + std::to_string(mode) + "; allowed: NONE, BIND, CONNECT");
+    }
+    if (mode == protocol::DataPlane::BIND && options_.role != protocol::SOLID) {
+      throw proto::ProtocolError("Welcome asks a " + role_ + " side to bind the data plane; only the solid binds");
+    }
     has_peer_ = mode == protocol::DataPlane::BIND || mode == protocol::DataPlane::CONNECT;
     if (has_peer_) {
       data_.emplace(context_, zmq::socket_type::pair);
@@ -327,7 +345,32 @@ class SideRuntime {
         frame->mutable_fluid()->mutable_cracks(0)->set_pressure(0, std::numeric_limits<double>::quiet_NaN());
       }
     }
-    send(*data_, envelope);
+    send_data(envelope);
+  }
+
+  // A PAIR socket blocks a send until its peer is connected: wait for that
+  // while watching the coupler, as consume() does.
+  void send_data(const protocol::Envelope& envelope) {
+    const std::string bytes = proto::encode(envelope);
+    while (!data_->send(zmq::buffer(bytes), zmq::send_flags::dontwait)) {
+      zmq::pollitem_t items[] = {{data_->handle(), 0, ZMQ_POLLOUT, 0}, {control_.handle(), 0, ZMQ_POLLIN, 0}};
+      zmq::poll(items, 2, std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_));
+      if (items[1].revents & ZMQ_POLLIN) watch_coupler("to send data to the " + peer_ + " side");
+      if (!(items[0].revents & ZMQ_POLLOUT) && Clock::now() - last_from_coupler_ > heartbeat_timeout_) {
+        throw CouplerLost{"nothing from the coupler for " +
+                          std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) +
+                          " s while waiting to send data to the " + peer_ + " side"};
+      }
+    }
+  }
+
+  // One message from the coupler while busy on the data plane: a heartbeat or Shutdown.
+  void watch_coupler(const std::string& doing) {
+    auto envelope = receive(control_, "the coupler", microseconds(0));
+    if (!envelope) return;
+    last_from_coupler_ = Clock::now();
+    if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
+    if (!envelope->has_heartbeat()) unexpected(*envelope, "nothing while waiting " + doing);
   }
 
   // Waits for the peer's frame of step `expected`, watching the coupler meanwhile.
@@ -348,16 +391,12 @@ class SideRuntime {
         auto envelope = receive(*data_, "the " + peer_ + " side (data plane)", microseconds(0));
         if (!envelope) continue;
         check_frame(*envelope, expected);
+        model_.receive(envelope->data());  // validates the frame (throws ProtocolError)
         if (log_) log_->write(envelope->data());
-        model_.receive(envelope->data());
         return;
       }
       if (items[1].revents & ZMQ_POLLIN) {
-        auto envelope = receive(control_, "the coupler", microseconds(0));
-        if (!envelope) continue;
-        last_from_coupler_ = Clock::now();
-        if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
-        if (!envelope->has_heartbeat()) unexpected(*envelope, "data from the " + peer_ + " side");
+        watch_coupler("for data from the " + peer_ + " side");
         continue;
       }
       if (!spinning && Clock::now() - last_from_coupler_ > heartbeat_timeout_) {

@@ -26,7 +26,8 @@ class PrescribedFluidSide final : public coupling::SideModel {
   double stable_dt() const override { return fluid_->stable_dt(); }
   void advance(double dt) override { fluid_->advance(dt); }
   void publish(protocol::DataFrame& frame) override {
-    for (const auto& p : fluid_->pressures()) proto::to_proto(p, frame.mutable_fluid()->add_cracks());
+    auto* state = frame.mutable_fluid();  // a FluidState even when there is no crack yet
+    for (const auto& p : fluid_->pressures()) proto::to_proto(p, state->add_cracks());
   }
   void receive(const protocol::DataFrame& frame) override {
     std::vector<CrackGeometry> cracks;

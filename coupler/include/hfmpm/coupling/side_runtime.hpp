@@ -63,7 +63,16 @@ struct SideOptions {
 };
 
 // Exit codes of a side.
-enum SideExit : int { kSideOk = 0, kSideFailed = 1, kSideInput = 2, kSideProtocol = 3, kSideCouplerLost = 4 };
+// kSideStoppedOnError: told to stop by a Shutdown with error = true (the run
+// failed elsewhere); this side itself did nothing wrong.
+enum SideExit : int {
+  kSideOk = 0,
+  kSideFailed = 1,
+  kSideInput = 2,
+  kSideProtocol = 3,
+  kSideCouplerLost = 4,
+  kSideStoppedOnError = 5
+};
 
 // Runs the side until Shutdown or failure; never throws. Returns a SideExit.
 int run_side(SideModel& model, const SideOptions& options);
