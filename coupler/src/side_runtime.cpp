@@ -106,10 +106,10 @@ class SideRuntime {
       handshake();
       start();
       loop();
-      model_.finish();
+      finish();
       return kSideOk;
     } catch (const ShutdownRequested& shutdown) {
-      model_.finish();
+      finish();
       return shutdown.error ? kSideStoppedOnError : kSideOk;
     } catch (const CouplerLost& lost) {
       std::cerr << role_ << ": " << lost.what << "; exiting\n";
@@ -124,6 +124,11 @@ class SideRuntime {
   }
 
  private:
+  // The model's finish() runs only for a model that was set up.
+  void finish() {
+    if (set_up_) model_.finish();
+  }
+
   int fail(const std::string& what, const std::string& message, int code) {
     std::cerr << role_ << " side error (" << what << ") at step " << step_ << ": " << message << "\n";
     try {
@@ -198,6 +203,7 @@ class SideRuntime {
     const std::string output_dir = chosen.empty() ? std::string(".") : chosen;
     std::filesystem::create_directories(output_dir);
     model_.setup(scene, output_dir);
+    set_up_ = true;
     if (scene.output().exchange_log()) log_ = std::make_unique<ExchangeLog>(output_dir, role_);
 
     heartbeat_->set_interval(scene.coupling().heartbeat_interval_s());
@@ -481,6 +487,7 @@ class SideRuntime {
   bool gauss_seidel_ = false;
   bool has_peer_ = false;
   bool poison_next_frame_ = false;
+  bool set_up_ = false;
   std::uint64_t step_ = 0;
   double t_ = 0;
 };
