@@ -318,11 +318,7 @@ class Coupler {
     for (auto& side : sides_) {
       if (!side.expected || side.stopping) continue;
       if (side.process) {
-        if (auto ended = side.process->poll()) {
-          const std::string reported = drain_error_from(side);
-          throw RunFailure{"the " + side.name + " side (pid " + std::to_string(side.process->pid()) + ") " + *ended +
-                           at_step() + (reported.empty() ? "" : ": " + reported) + log_hint(side)};
-        }
+        if (auto ended = side.process->poll()) throw RunFailure{ended_message(side, *ended)};
       }
       if (side.thread_exit && side.thread_exit->load() >= 0) {
         const std::string reported = drain_error_from(side);
@@ -347,6 +343,12 @@ class Coupler {
     }
   }
 
+  std::string ended_message(Side& side, const std::string& ended) {
+    const std::string reported = drain_error_from(side);
+    return "the " + side.name + " side (pid " + std::to_string(side.process->pid()) + ") " + ended + at_step() +
+           (reported.empty() ? "" : ": " + reported) + log_hint(side);
+  }
+
   // After a side ended: its last words, if it sent an Error before going.
   std::string drain_error_from(Side& side) {
     const auto until = Clock::now() + milliseconds(200);
@@ -367,6 +369,8 @@ class Coupler {
       send_routed(router_, side.name, envelope);
       side.last_sent = Clock::now();
     } catch (const std::exception& e) {
+      // Usually the process has just died: say how, rather than that a send failed.
+      if (side.process && side.process->wait_for(0.5)) throw RunFailure{ended_message(side, *side.process->poll())};
       throw RunFailure{"cannot reach the " + side.name + " side" + at_step() + ": " + e.what() + log_hint(side)};
     }
   }

@@ -1,5 +1,6 @@
 #include "hfmpm/coupling/side_runtime.hpp"
 
+#include <malloc.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -520,6 +521,16 @@ Fault Fault::parse(const std::string& text) {
 }
 
 int run_side(SideModel& model, const SideOptions& options) {
+  // A side allocates and frees the same large buffers (frames of thousands of
+  // crack particles) at every exchange. Keep freed memory in the process
+  // instead of returning it to the kernel and faulting it back in each time:
+  // measured at 5000 crack particles this halves the exchange cost.
+  static const bool tuned = [] {
+    mallopt(M_MMAP_THRESHOLD, 64 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+    return true;
+  }();
+  (void)tuned;
   try {
     SideRuntime runtime(model, options);
     try {

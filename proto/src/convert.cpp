@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <string>
-#include <unordered_set>
+#include <vector>
 
 #include "hfmpm/proto/convert.hpp"
 
@@ -32,12 +34,17 @@ void check_finite(std::string_view type, std::uint32_t crack_id, const char* nam
 
 template <class Repeated>
 void check_unique_ids(std::string_view type, std::uint32_t crack_id, const Repeated& ids) {
-  std::unordered_set<std::uint64_t> seen;
-  seen.reserve(static_cast<std::size_t>(ids.size()));
-  for (int i = 0; i < ids.size(); ++i) {
-    if (!seen.insert(ids[i]).second) {
-      fail(type, crack_id, "id " + std::to_string(ids[i]) + " appears twice (at index " + std::to_string(i) + ")");
-    }
+  // Ids are usually increasing (appended at the tip): then they are unique, in O(n).
+  if (std::adjacent_find(ids.begin(), ids.end(), std::greater_equal<>()) == ids.end()) return;
+  std::vector<std::uint64_t> sorted(ids.begin(), ids.end());
+  std::sort(sorted.begin(), sorted.end());
+  const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+  if (twice != sorted.end()) {
+    const auto first = std::find(ids.begin(), ids.end(), *twice);
+    const auto second = std::find(std::next(first), ids.end(), *twice);
+    fail(type, crack_id,
+         "id " + std::to_string(*twice) + " appears twice (at index " + std::to_string(first - ids.begin()) +
+             " and index " + std::to_string(second - ids.begin()) + ")");
   }
 }
 

@@ -39,7 +39,13 @@ double PrescribedCrack::width_at(double s) const {
 }
 
 void PrescribedCrack::update_widths() {
-  for (std::size_t i = 0; i < crack_.size(); ++i) crack_.width[i] = width_at(arc_[i]);
+  const double w0 = std::max(0.0, config_.mouth_opening(t_));
+  const double length = arc_.back();
+  const bool elliptic = config_.profile == PrescribedCrackConfig::Profile::Elliptic;
+  for (std::size_t i = 0; i < crack_.size(); ++i) {
+    const double r = arc_[i] / length;
+    crack_.width[i] = arc_[i] >= length ? 0.0 : elliptic ? w0 * std::sqrt(std::max(0.0, 1.0 - r * r)) : w0;
+  }
 }
 
 void PrescribedCrack::advance(double dt) {
