@@ -1,0 +1,70 @@
+// What an MPM solid is built from: grid, materials, regions (bonded into one
+// body), constraints, edge tractions, silent edges, damping. Plain C++; the
+// side adapter fills it from the scene.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "hfmpm/solid/mpm/grid.hpp"
+#include "hfmpm/solid/mpm/material.hpp"
+#include "hfmpm/solid/mpm/particles.hpp"
+#include "hfmpm/time_function.hpp"
+
+namespace hfmpm::solid::mpm {
+
+// A part of the body with one material and one initial (in-situ) stress.
+// Regions are bonded; where they overlap, the later one wins.
+struct Region {
+  enum class Kind { Rectangle, Polygon, Layer };
+  Kind kind = Kind::Rectangle;
+  Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();  // Rectangle corners; Layer uses lo.y() .. hi.y()
+  std::vector<Vec2> polygon;                   // Polygon vertices, either orientation
+  int material = 0;
+  Voigt initial_stress = Voigt::Zero();  // Pa, (xx, yy, xy, zz), tension positive
+
+  bool contains(const Vec2& p) const;
+};
+
+enum class Edge { Left, Right, Bottom, Top };
+
+// Zero grid velocity components: on a symmetry plane x = c (or y = c) the
+// normal component; in a box, the chosen components.
+struct Constraint {
+  enum class Kind { PlaneX, PlaneY, Box };
+  Kind kind = Kind::PlaneX;
+  double coordinate = 0;                       // m, PlaneX / PlaneY; must lie on a grid line
+  Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();   // Box
+  bool fix_x = true, fix_y = true;             // Box
+};
+
+// Traction on the particles along one edge of the body: normal (tension
+// positive, so a confining stress S is normal = -S) and shear (along the edge,
+// counter-clockwise positive), both functions of time, Pa.
+struct Traction {
+  Edge edge = Edge::Left;
+  TimeFunction normal = TimeFunction::constant(0);
+  TimeFunction shear = TimeFunction::constant(0);
+};
+
+struct Damping {
+  double grid_alpha = 0;  // 1/s: grid force -= alpha * momentum
+  double pic_fraction = 0;  // 0 = pure FLIP, 1 = pure PIC velocity update
+};
+
+struct SolidConfig {
+  Grid grid;
+  std::vector<Material> materials;
+  std::vector<Region> regions;
+  int particles_per_cell = 2;    // per direction
+  double cfl = 0.4;              // dt = cfl * h / c_p (with scaled density)
+  double density_scaling = 1;    // every density is multiplied by this (>= 1 for quasi-static speed)
+  std::vector<Constraint> constraints;
+  std::vector<Traction> tractions;
+  std::vector<Edge> silent_edges;  // absorbing (dashpot) edges
+  Damping damping;
+  int threads = 1;
+};
+
+}  // namespace hfmpm::solid::mpm

@@ -1,0 +1,40 @@
+// Material points in structure-of-arrays form. Units SI, per unit thickness.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "hfmpm/exchange.hpp"
+
+namespace hfmpm::solid::mpm {
+
+// Stress or strain in plane strain as (xx, yy, xy, zz); tension positive.
+using Voigt = Eigen::Vector4d;
+
+struct Particles {
+  std::vector<Vec2> x;            // m, position
+  std::vector<Vec2> v;            // m/s, velocity
+  std::vector<double> mass;       // kg/m (after density scaling)
+  std::vector<double> volume;     // m^2, initial area (small strain: kept constant)
+  std::vector<double> half_size;  // m, uGIMP half-width lp
+  std::vector<Voigt> stress;      // Pa, Cauchy stress including the initial stress
+  std::vector<Voigt> strain;      // -, small strain since the start (eps_zz = 0)
+  std::vector<Vec2> external;     // N/m, external force on the particle this step (tractions, dashpots)
+  std::vector<std::int32_t> material;  // index into the material table
+
+  std::size_t size() const { return x.size(); }
+  void add(const Vec2& position, double m, double v0, double lp, const Voigt& initial_stress, std::int32_t mat) {
+    x.push_back(position);
+    v.push_back(Vec2::Zero());
+    mass.push_back(m);
+    volume.push_back(v0);
+    half_size.push_back(lp);
+    stress.push_back(initial_stress);
+    strain.push_back(Voigt::Zero());
+    external.push_back(Vec2::Zero());
+    material.push_back(mat);
+  }
+};
+
+}  // namespace hfmpm::solid::mpm

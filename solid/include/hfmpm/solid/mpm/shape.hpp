@@ -1,0 +1,63 @@
+// Shape functions of the background grid (uniform square cells of size h).
+//
+// uGIMP (Bardenhagen and Kober 2004, "The generalized interpolation material
+// point method", CMES 5(6), eq. 34 with a particle of half-width lp <= h/2 that
+// keeps its initial size): the hat function convolved with the particle's box.
+// A particle touches up to 3 nodes per direction, 9 in 2D. Linear (classic MPM)
+// is the limit lp -> 0 and touches 2 nodes per direction.
+#pragma once
+
+#include <array>
+#include <cmath>
+
+namespace hfmpm::solid::mpm {
+
+// 1D uGIMP weight and its derivative for a node at distance d = x_p - x_i.
+struct Weight1D {
+  double s = 0;  // shape function value
+  double g = 0;  // derivative with respect to x_p
+};
+
+inline Weight1D ugimp_1d(double d, double h, double lp) {
+  const double a = std::abs(d);
+  const double sign = d < 0 ? -1.0 : 1.0;
+  if (a < lp) return {1 - (d * d + lp * lp) / (2 * h * lp), -d / (h * lp)};
+  if (a <= h - lp) return {1 - a / h, -sign / h};
+  if (a < h + lp) {
+    const double r = h + lp - a;
+    return {r * r / (4 * h * lp), -sign * r / (2 * h * lp)};
+  }
+  return {};
+}
+
+inline Weight1D linear_1d(double d, double h) {
+  const double a = std::abs(d);
+  if (a >= h) return {};
+  return {1 - a / h, (d < 0 ? 1.0 : -1.0) / h};
+}
+
+// The 3 nodes per direction a uGIMP particle may touch: first node index and
+// the weights at first, first+1, first+2 (zeros where it does not reach).
+struct Stencil1D {
+  int first = 0;
+  std::array<double, 3> s{};
+  std::array<double, 3> g{};
+};
+
+// x: particle coordinate relative to the grid origin, h: cell size, lp: half-width.
+inline Stencil1D ugimp_stencil(double x, double h, double lp) {
+  Stencil1D st;
+  const double xi = x / h;
+  // The nearest node: the particle's box [x - lp, x + lp] with lp <= h/2 lies
+  // within (nearest - 1) .. (nearest + 1) cells' support.
+  const int nearest = static_cast<int>(std::floor(xi + 0.5));
+  st.first = nearest - 1;
+  for (int k = 0; k < 3; ++k) {
+    const auto w = ugimp_1d(x - (st.first + k) * h, h, lp);
+    st.s[static_cast<std::size_t>(k)] = w.s;
+    st.g[static_cast<std::size_t>(k)] = w.g;
+  }
+  return st;
+}
+
+}  // namespace hfmpm::solid::mpm

@@ -1,0 +1,73 @@
+// Explicit 2D plane-strain MPM (uGIMP shape functions, update stress last).
+//
+// One step (USL; Sulsky, Chen and Schreyer 1994, with uGIMP weights):
+//   1. P2G: nodal mass, momentum and force (internal -V sigma . grad S, and
+//      edge tractions / dashpots integrated along the body's edge);
+//   2. grid: damping, momentum update p += f dt, velocity constraints;
+//   3. G2P: particle velocity (FLIP with an optional PIC fraction) and position
+//      from the new nodal velocities, and in the same pass the strain
+//      increment dt sym(grad v) and the elastic stress update.
+// USL because it needs two particle passes per step (USF needs three); the
+// stress then uses the velocity at the end of the step, which suits the
+// damped, quasi-static loading of hydraulic fracture.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hfmpm/solid/mpm/config.hpp"
+#include "hfmpm/solid/mpm/grid.hpp"
+#include "hfmpm/solid/mpm/particles.hpp"
+
+namespace hfmpm::solid::mpm {
+
+class Solver {
+ public:
+  explicit Solver(SolidConfig config);
+
+  void step(double dt);
+  // cfl * h / (fastest P-wave speed with the scaled densities)
+  double stable_dt() const;
+
+  double time() const { return t_; }
+  std::uint64_t steps() const { return steps_; }
+  double kinetic_energy() const;  // J/m, with the scaled masses
+  const SolidConfig& config() const { return config_; }
+  const Grid& grid() const { return config_.grid; }
+  Particles& particles() { return particles_; }
+  const Particles& particles() const { return particles_; }
+  const NodalFields& nodes() const { return nodes_; }
+  const std::vector<int>& active_nodes() const { return active_; }
+  // Particles on each edge of the body (Left, Right, Bottom, Top), found once.
+  const std::vector<std::uint32_t>& edge_particles(Edge edge) const {
+    return edges_[static_cast<std::size_t>(edge)];
+  }
+
+ private:
+  void generate_particles();
+  void build_constraints();
+  void find_edges();
+  void p2g();
+  void edge_loads();
+  void grid_update(double dt);
+  void g2p(double dt);
+
+  SolidConfig config_;
+  Particles particles_;
+  NodalFields nodes_;                 // reduced fields
+  std::vector<NodalFields> thread_nodes_;
+  std::vector<std::vector<int>> thread_touched_;
+  std::vector<std::vector<std::uint32_t>> thread_stamp_;
+  std::vector<std::uint32_t> stamp_;
+  std::vector<int> active_;
+  std::vector<Vec2> velocity_;        // new nodal velocity, per node
+  std::vector<Vec2> acceleration_;    // nodal acceleration, per node
+  std::vector<std::uint32_t> edges_[4];
+  std::vector<double> lambda_, shear_, p_modulus_, density_;  // per material, density scaled
+  std::uint32_t epoch_ = 0;
+  double t_ = 0;
+  std::uint64_t steps_ = 0;
+  double min_mass_ = 0;  // nodes lighter than this get zero velocity
+};
+
+}  // namespace hfmpm::solid::mpm

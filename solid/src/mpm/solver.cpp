@@ -1,0 +1,377 @@
+#include "hfmpm/solid/mpm/solver.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "hfmpm/solid/mpm/shape.hpp"
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+Vec2 outward_normal(Edge edge) {
+  switch (edge) {
+    case Edge::Left: return {-1, 0};
+    case Edge::Right: return {1, 0};
+    case Edge::Bottom: return {0, -1};
+    case Edge::Top: return {0, 1};
+  }
+  return {0, 0};
+}
+
+// Counter-clockwise tangent of an edge with outward normal n.
+Vec2 tangent(const Vec2& n) { return {-n.y(), n.x()}; }
+
+}  // namespace
+
+Solver::Solver(SolidConfig config) : config_(std::move(config)) {
+  if (config_.materials.empty()) throw std::invalid_argument("an MPM solid needs at least one material");
+  for (const auto& m : config_.materials) {
+    const double rho = m.density * config_.density_scaling;
+    lambda_.push_back(m.lame_lambda());
+    shear_.push_back(m.shear_modulus());
+    p_modulus_.push_back(m.p_modulus());
+    density_.push_back(rho);
+  }
+  const std::size_t n = config_.grid.node_count();
+  nodes_.resize(n);
+  stamp_.assign(n, 0);
+  velocity_.assign(n, Vec2::Zero());
+  acceleration_.assign(n, Vec2::Zero());
+  const int threads = std::max(1, config_.threads);
+  thread_nodes_.resize(static_cast<std::size_t>(threads));
+  thread_touched_.resize(static_cast<std::size_t>(threads));
+  thread_stamp_.resize(static_cast<std::size_t>(threads));
+  for (int k = 0; k < threads; ++k) {
+    thread_nodes_[static_cast<std::size_t>(k)].resize(n);
+    thread_stamp_[static_cast<std::size_t>(k)].assign(n, 0);
+  }
+  generate_particles();
+  build_constraints();
+  find_edges();
+  double lightest = std::numeric_limits<double>::infinity();
+  for (double m : particles_.mass) lightest = std::min(lightest, m);
+  min_mass_ = 1e-9 * lightest;
+}
+
+void Solver::generate_particles() {
+  const auto& g = config_.grid;
+  const int ppc = config_.particles_per_cell;
+  const double spacing = g.h / ppc;
+  for (int j = 0; j < g.ny; ++j) {
+    for (int b = 0; b < ppc; ++b) {
+      for (int i = 0; i < g.nx; ++i) {
+        for (int a = 0; a < ppc; ++a) {
+          const Vec2 x = g.origin + Vec2((i + (a + 0.5) / ppc) * g.h, (j + (b + 0.5) / ppc) * g.h);
+          const Region* found = nullptr;
+          for (const auto& r : config_.regions) {
+            if (r.contains(x)) found = &r;  // later regions win
+          }
+          if (!found) continue;
+          const auto mat = static_cast<std::size_t>(found->material);
+          const double volume = spacing * spacing;
+          particles_.add(x, density_[mat] * volume, volume, spacing / 2, found->initial_stress, found->material);
+        }
+      }
+    }
+  }
+  if (particles_.size() == 0) throw std::invalid_argument("the regions contain no particle: the body is empty");
+}
+
+void Solver::build_constraints() {
+  const auto& g = config_.grid;
+  const double tol = 1e-9 * g.h;
+  for (const auto& c : config_.constraints) {
+    int count = 0;
+    for (std::size_t n = 0; n < g.node_count(); ++n) {
+      const Vec2 x = g.position(static_cast<int>(n));
+      std::uint8_t mask = 0;
+      if (c.kind == Constraint::Kind::PlaneX && std::abs(x.x() - c.coordinate) < tol) mask = 1;
+      if (c.kind == Constraint::Kind::PlaneY && std::abs(x.y() - c.coordinate) < tol) mask = 2;
+      if (c.kind == Constraint::Kind::Box && (x.array() >= c.lo.array() - tol).all() &&
+          (x.array() <= c.hi.array() + tol).all()) {
+        mask = static_cast<std::uint8_t>((c.fix_x ? 1 : 0) | (c.fix_y ? 2 : 0));
+      }
+      if (mask) {
+        nodes_.fixed[n] |= mask;
+        ++count;
+      }
+    }
+    if (count == 0) {
+      std::ostringstream out;
+      out << "a velocity constraint selects no grid node (symmetry planes must lie on a grid line: x0 + k h)";
+      throw std::invalid_argument(out.str());
+    }
+  }
+}
+
+void Solver::find_edges() {
+  Vec2 lo = Vec2::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const Vec2 half = Vec2::Constant(particles_.half_size[p]);
+    lo = lo.cwiseMin(particles_.x[p] - half);
+    hi = hi.cwiseMax(particles_.x[p] + half);
+  }
+  const double tol = 1e-6 * config_.grid.h;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const Vec2 a = particles_.x[p] - Vec2::Constant(particles_.half_size[p]);
+    const Vec2 b = particles_.x[p] + Vec2::Constant(particles_.half_size[p]);
+    const auto id = static_cast<std::uint32_t>(p);
+    if (a.x() - lo.x() < tol) edges_[static_cast<std::size_t>(Edge::Left)].push_back(id);
+    if (hi.x() - b.x() < tol) edges_[static_cast<std::size_t>(Edge::Right)].push_back(id);
+    if (a.y() - lo.y() < tol) edges_[static_cast<std::size_t>(Edge::Bottom)].push_back(id);
+    if (hi.y() - b.y() < tol) edges_[static_cast<std::size_t>(Edge::Top)].push_back(id);
+  }
+}
+
+double Solver::stable_dt() const {
+  double fastest = 0;
+  for (std::size_t m = 0; m < p_modulus_.size(); ++m) fastest = std::max(fastest, std::sqrt(p_modulus_[m] / density_[m]));
+  return config_.cfl * config_.grid.h / fastest;
+}
+
+double Solver::kinetic_energy() const {
+  double e = 0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) e += 0.5 * particles_.mass[p] * particles_.v[p].squaredNorm();
+  return e;
+}
+
+void Solver::step(double dt) {
+  ++epoch_;
+  p2g();
+  edge_loads();
+  grid_update(dt);
+  g2p(dt);
+  t_ += dt;
+  ++steps_;
+}
+
+void Solver::p2g() {
+  const auto& g = config_.grid;
+  const int threads = static_cast<int>(thread_nodes_.size());
+  const std::size_t count = particles_.size();
+  const std::uint32_t epoch = epoch_;
+#pragma omp parallel num_threads(threads)
+  {
+    const auto k = static_cast<std::size_t>(omp_get_thread_num());
+    auto& f = thread_nodes_[k];
+    auto& touched = thread_touched_[k];
+    auto& stamp = thread_stamp_[k];
+    touched.clear();
+    const std::size_t begin = count * k / thread_nodes_.size();
+    const std::size_t end = count * (k + 1) / thread_nodes_.size();
+    for (std::size_t p = begin; p < end; ++p) {
+      const Vec2 rel = particles_.x[p] - g.origin;
+      const double lp = particles_.half_size[p];
+      const auto sx = ugimp_stencil(rel.x(), g.h, lp);
+      const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+      const double m = particles_.mass[p];
+      const Vec2 mv = m * particles_.v[p];
+      const Voigt& s = particles_.stress[p];
+      const double vol = particles_.volume[p];
+      for (int b = 0; b < 3; ++b) {
+        const int j = sy.first + b;
+        if (j < 0 || j > g.ny) continue;
+        for (int a = 0; a < 3; ++a) {
+          const int i = sx.first + a;
+          if (i < 0 || i > g.nx) continue;
+          const double w = sx.s[static_cast<std::size_t>(a)] * sy.s[static_cast<std::size_t>(b)];
+          if (w == 0) continue;
+          const double gx = sx.g[static_cast<std::size_t>(a)] * sy.s[static_cast<std::size_t>(b)];
+          const double gy = sx.s[static_cast<std::size_t>(a)] * sy.g[static_cast<std::size_t>(b)];
+          const auto n = static_cast<std::size_t>(g.node(i, j));
+          if (stamp[n] != epoch) {
+            stamp[n] = epoch;
+            touched.push_back(static_cast<int>(n));
+            f.mass[n] = 0;
+            f.momentum[n].setZero();
+            f.force[n].setZero();
+          }
+          f.mass[n] += w * m;
+          f.momentum[n] += w * mv;
+          // internal force -V sigma . grad S (s = xx, yy, xy, zz)
+          f.force[n] -= vol * Vec2(s[0] * gx + s[2] * gy, s[2] * gx + s[1] * gy);
+        }
+      }
+    }
+  }
+  // Reduce the threads' fields into the active nodes.
+  active_.clear();
+  for (std::size_t k = 0; k < thread_nodes_.size(); ++k) {
+    const auto& f = thread_nodes_[k];
+    for (int n : thread_touched_[k]) {
+      const auto u = static_cast<std::size_t>(n);
+      if (stamp_[u] != epoch) {
+        stamp_[u] = epoch;
+        active_.push_back(n);
+        nodes_.mass[u] = f.mass[u];
+        nodes_.momentum[u] = f.momentum[u];
+        nodes_.force[u] = f.force[u];
+      } else {
+        nodes_.mass[u] += f.mass[u];
+        nodes_.momentum[u] += f.momentum[u];
+        nodes_.force[u] += f.force[u];
+      }
+    }
+  }
+}
+
+// Tractions and dashpots act on the body's edge: each edge particle carries
+// traction x its edge length 2 lp, spread along the edge with its uGIMP
+// weights and across it with the linear weights at the edge line itself, so a
+// uniform stress held by equal tractions is in exact equilibrium.
+void Solver::edge_loads() {
+  const auto& g = config_.grid;
+  auto spread = [&](std::uint32_t p, const Vec2& n, const Vec2& force) {
+    const double lp = particles_.half_size[p];
+    const Vec2 rel = particles_.x[p] + lp * n - g.origin;  // point on the edge line
+    const bool vertical_edge = n.x() != 0;
+    const auto along = ugimp_stencil(vertical_edge ? rel.y() : rel.x(), g.h, lp);
+    const double across = vertical_edge ? rel.x() : rel.y();
+    const int base = static_cast<int>(std::floor(across / g.h));
+    for (int c = 0; c < 2; ++c) {
+      const double w_across = linear_1d(across - (base + c) * g.h, g.h).s;
+      if (w_across == 0) continue;
+      for (int a = 0; a < 3; ++a) {
+        const double w = w_across * along.s[static_cast<std::size_t>(a)];
+        if (w == 0) continue;
+        const int i = vertical_edge ? base + c : along.first + a;
+        const int j = vertical_edge ? along.first + a : base + c;
+        if (!g.inside(i, j)) continue;
+        const auto node = static_cast<std::size_t>(g.node(i, j));
+        if (stamp_[node] != epoch_) continue;  // no mass there: nothing to push
+        nodes_.force[node] += w * force;
+      }
+    }
+  };
+  for (const auto& traction : config_.tractions) {
+    const Vec2 n = outward_normal(traction.edge);
+    const Vec2 t = traction.normal(t_) * n + traction.shear(t_) * tangent(n);
+    for (std::uint32_t p : edges_[static_cast<std::size_t>(traction.edge)]) {
+      spread(p, n, t * 2 * particles_.half_size[p]);
+    }
+  }
+  for (Edge edge : config_.silent_edges) {
+    // Lysmer-Kuhlemeyer dashpots: t = -rho (c_p v_n n + c_s v_t t)
+    const Vec2 n = outward_normal(edge);
+    const Vec2 tg = tangent(n);
+    for (std::uint32_t p : edges_[static_cast<std::size_t>(edge)]) {
+      const auto m = static_cast<std::size_t>(particles_.material[p]);
+      const double rho = density_[m];
+      const double cp = std::sqrt(p_modulus_[m] / rho), cs = std::sqrt(shear_[m] / rho);
+      const Vec2& v = particles_.v[p];
+      const Vec2 traction = -rho * (cp * v.dot(n) * n + cs * v.dot(tg) * tg);
+      spread(p, n, traction * 2 * particles_.half_size[p]);
+    }
+  }
+}
+
+void Solver::grid_update(double dt) {
+  const double alpha = config_.damping.grid_alpha;
+  for (int n : active_) {
+    const auto u = static_cast<std::size_t>(n);
+    const double m = nodes_.mass[u];
+    if (m <= min_mass_) {
+      velocity_[u].setZero();
+      acceleration_[u].setZero();
+      continue;
+    }
+    Vec2 f = nodes_.force[u] - alpha * nodes_.momentum[u];
+    Vec2 p = nodes_.momentum[u] + dt * f;
+    const std::uint8_t fixed = nodes_.fixed[u];
+    if (fixed & 1) f.x() = p.x() = 0;
+    if (fixed & 2) f.y() = p.y() = 0;
+    velocity_[u] = p / m;
+    acceleration_[u] = f / m;
+  }
+}
+
+void Solver::g2p(double dt) {
+  const auto& g = config_.grid;
+  const double pic = config_.damping.pic_fraction;
+  const Vec2 lo = g.origin, hi = g.origin + g.h * Vec2(g.nx, g.ny);
+  const auto count = static_cast<std::int64_t>(particles_.size());
+  std::int64_t escaped = -1;
+#pragma omp parallel for num_threads(static_cast<int>(thread_nodes_.size())) schedule(static)
+  for (std::int64_t q = 0; q < count; ++q) {
+    const auto p = static_cast<std::size_t>(q);
+    const Vec2 rel = particles_.x[p] - g.origin;
+    const double lp = particles_.half_size[p];
+    const auto sx = ugimp_stencil(rel.x(), g.h, lp);
+    const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+    Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
+    double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
+    for (int b = 0; b < 3; ++b) {
+      const int j = sy.first + b;
+      if (j < 0 || j > g.ny) continue;
+      for (int c = 0; c < 3; ++c) {
+        const int i = sx.first + c;
+        if (i < 0 || i > g.nx) continue;
+        const double w = sx.s[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
+        if (w == 0) continue;
+        const double gx = sx.g[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
+        const double gy = sx.s[static_cast<std::size_t>(c)] * sy.g[static_cast<std::size_t>(b)];
+        const auto n = static_cast<std::size_t>(g.node(i, j));
+        const Vec2& vn = velocity_[n];
+        v_new += w * vn;
+        a += w * acceleration_[n];
+        l00 += vn.x() * gx;
+        l01 += vn.x() * gy;
+        l10 += vn.y() * gx;
+        l11 += vn.y() * gy;
+      }
+    }
+    particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
+    particles_.x[p] += dt * v_new;
+    // Small-strain elastic update, plane strain (eps_zz = 0).
+    const double dxx = l00 * dt, dyy = l11 * dt, dxy = 0.5 * (l01 + l10) * dt;
+    const auto m = static_cast<std::size_t>(particles_.material[p]);
+    const double lam = lambda_[m], mu = shear_[m];
+    const double tr = dxx + dyy;
+    particles_.strain[p] += Voigt(dxx, dyy, dxy, 0);
+    particles_.stress[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
+    const Vec2& x = particles_.x[p];
+    if (!(x.x() >= lo.x() && x.y() >= lo.y() && x.x() <= hi.x() && x.y() <= hi.y())) {
+#pragma omp critical
+      escaped = q;
+    }
+  }
+  if (escaped >= 0) {
+    const auto p = static_cast<std::size_t>(escaped);
+    std::ostringstream out;
+    out << "particle " << p << " left the grid (or became NaN) at step " << steps_ + 1 << ": x = ("
+        << particles_.x[p].x() << ", " << particles_.x[p].y() << ") m, v = (" << particles_.v[p].x() << ", "
+        << particles_.v[p].y() << ") m/s; the step is probably unstable: lower the CFL factor or check the "
+        << "boundary conditions and loads";
+    throw std::runtime_error(out.str());
+  }
+}
+
+bool Region::contains(const Vec2& p) const {
+  switch (kind) {
+    case Kind::Rectangle:
+      return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
+    case Kind::Layer:
+      return p.y() >= lo.y() && p.y() <= hi.y();
+    case Kind::Polygon: {
+      // Even-odd rule by crossings of a ray in +x.
+      bool inside = false;
+      for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+        const Vec2& a = polygon[i];
+        const Vec2& b = polygon[j];
+        if ((a.y() > p.y()) != (b.y() > p.y()) &&
+            p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+          inside = !inside;
+        }
+      }
+      return inside;
+    }
+  }
+  return false;
+}
+
+}  // namespace hfmpm::solid::mpm
