@@ -8,6 +8,7 @@
 
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
+#include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
 
@@ -41,8 +42,10 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::unique_ptr<coupling::SideModel> make_inproc_side(protocol::Role role, const scene::Scene&) {
-  if (role == protocol::SOLID) return solid::make_prescribed_solid_side();
+std::unique_ptr<coupling::SideModel> make_inproc_side(protocol::Role role, const scene::Scene& scene) {
+  if (role == protocol::SOLID) {
+    return scene.solid().has_mpm() ? solid::make_mpm_solid_side() : solid::make_prescribed_solid_side();
+  }
   return fluid::make_prescribed_fluid_side();
 }
 

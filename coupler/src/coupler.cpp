@@ -218,7 +218,9 @@ class Coupler {
     const std::string& chosen = side.role == protocol::SOLID ? options_.solid_program : options_.fluid_program;
     if (!chosen.empty()) return chosen;
     const std::string dir = options_.executable_dir.empty() ? executable_dir() : options_.executable_dir;
-    if (side.role == protocol::SOLID) return dir + "/hfmpm-prescribed-solid";
+    if (side.role == protocol::SOLID) {
+      return dir + (scene_.solid().has_mpm() ? "/hfmpm-solid" : "/hfmpm-prescribed-solid");
+    }
     return dir + "/hfmpm-prescribed-fluid";
   }
 

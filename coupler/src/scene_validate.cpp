@@ -6,45 +6,9 @@
 #include <sstream>
 
 #include "hfmpm/coupling/scene_loader.hpp"
+#include "scene_checker.hpp"
 
 namespace hfmpm::coupling {
-namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-std::string text(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
-class Checker {
- public:
-  void missing(const std::string& key, const std::string& what) { problems_.push_back({key, "", what}); }
-  void bad(const std::string& key, const std::string& value, const std::string& allowed) {
-    problems_.push_back({key, value, allowed});
-  }
-  // lo < v (or lo <= v) and v <= hi, finite.
-  void range(const std::string& key, double v, double lo, double hi, bool lo_open, const std::string& unit) {
-    const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && v <= hi;
-    if (!ok) {
-      std::string allowed = std::string("a finite value ") + (lo_open ? "> " : ">= ") + text(lo);
-      if (std::isfinite(hi)) allowed += " and <= " + text(hi);
-      if (!unit.empty()) allowed += " (" + unit + ")";
-      bad(key, text(v), allowed);
-    }
-  }
-  void positive(const std::string& key, double v, const std::string& unit) {
-    range(key, v, 0, kInf, true, unit);
-  }
-  void non_negative(const std::string& key, double v, const std::string& unit) {
-    range(key, v, 0, kInf, false, unit);
-  }
-  std::vector<SceneProblem> take() { return std::move(problems_); }
-
- private:
-  std::vector<SceneProblem> problems_;
-};
 
 // `min_value`: the smallest value the function may take (e.g. 0 for an opening).
 void check_time_function(Checker& c, const std::string& key, const scene::TimeFunction& f, double min_value,
@@ -92,6 +56,8 @@ void check_time_function(Checker& c, const std::string& key, const scene::TimeFu
     }
   }
 }
+
+namespace {
 
 void check_time(Checker& c, const scene::Scene& s) {
   if (!s.has_time() || !s.time().has_end_s()) {
@@ -187,9 +153,11 @@ std::vector<SceneProblem> validate(const scene::Scene& s) {
   check_time(c, s);
   check_coupling(c, s.coupling());
   if (!s.has_solid() || s.solid().model_case() == scene::Solid::MODEL_NOT_SET) {
-    c.missing("solid", "a solid model: solid { prescribed_crack { ... } }");
+    c.missing("solid", "a solid model: solid { mpm { ... } } or solid { prescribed_crack { ... } }");
   } else if (s.solid().has_prescribed_crack()) {
     check_prescribed_crack(c, s.solid().prescribed_crack());
+  } else if (s.solid().has_mpm()) {
+    check_mpm_solid(c, s.solid().mpm());
   }
   if (s.has_fluid()) {
     if (s.fluid().model_case() == scene::Fluid::MODEL_NOT_SET) {

@@ -1,0 +1,139 @@
+// Rules for solid.mpm: grid, materials, regions, constraints, tractions.
+#include <set>
+
+#include "scene_checker.hpp"
+
+namespace hfmpm::coupling {
+namespace {
+
+// True if v is a whole number of cells from the grid origin (to 1e-9 cells).
+bool on_grid_line(double v, double origin, double h) {
+  const double k = (v - origin) / h;
+  return std::abs(k - std::round(k)) < 1e-9 * std::max(1.0, std::abs(k));
+}
+
+void check_box(Checker& c, const std::string& key, const scene::Box& b) {
+  for (const auto& [name, has, v] : {std::tuple{"x_min_m", b.has_x_min_m(), b.x_min_m()},
+                                     std::tuple{"y_min_m", b.has_y_min_m(), b.y_min_m()},
+                                     std::tuple{"x_max_m", b.has_x_max_m(), b.x_max_m()},
+                                     std::tuple{"y_max_m", b.has_y_max_m(), b.y_max_m()}}) {
+    if (!has) c.missing(key + "." + name, "a coordinate in m");
+    else c.range(key + "." + name, v, -kInf, kInf, false, "m");
+  }
+  if (b.x_max_m() <= b.x_min_m()) c.bad(key + ".x_max_m", text(b.x_max_m()), "> x_min_m = " + text(b.x_min_m()));
+  if (b.y_max_m() <= b.y_min_m()) c.bad(key + ".y_max_m", text(b.y_max_m()), "> y_min_m = " + text(b.y_min_m()));
+}
+
+}  // namespace
+
+void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
+  const std::string key = "solid.mpm.";
+  if (!m.has_grid()) c.missing(key + "grid", "the grid extent: grid { x_min_m: .. y_min_m: .. x_max_m: .. y_max_m: .. }");
+  else check_box(c, key + "grid", m.grid());
+  if (!m.has_cell_size_m()) {
+    c.missing(key + "cell_size_m", "the cell size (m), > 0");
+  } else {
+    c.positive(key + "cell_size_m", m.cell_size_m(), "m");
+    const double h = m.cell_size_m();
+    if (h > 0 && m.has_grid()) {
+      const auto& g = m.grid();
+      for (const auto& [name, lo, hi] : {std::tuple{"x_max_m", g.x_min_m(), g.x_max_m()},
+                                         std::tuple{"y_max_m", g.y_min_m(), g.y_max_m()}}) {
+        if (!on_grid_line(hi, lo, h)) {
+          c.bad(key + "grid." + name, text(hi), "a whole number of cells (cell_size_m = " + text(h) + ") from the minimum");
+        }
+      }
+      const double cells = (g.x_max_m() - g.x_min_m()) / h * (g.y_max_m() - g.y_min_m()) / h;
+      if (cells > 1e8) c.bad(key + "cell_size_m", text(h), "at most 1e8 cells in the grid");
+    }
+  }
+  std::set<std::string> names;
+  if (m.materials_size() == 0) c.missing(key + "materials", "at least one material { name: .. youngs_modulus_pa: .. }");
+  for (int i = 0; i < m.materials_size(); ++i) {
+    const auto& mat = m.materials(i);
+    const std::string k = key + "materials[" + std::to_string(i) + "].";
+    if (!mat.has_name() || mat.name().empty()) c.missing(k + "name", "a name the regions refer to");
+    else if (!names.insert(mat.name()).second) c.bad(k + "name", "\"" + mat.name() + "\"", "a name not used before");
+    if (!mat.has_youngs_modulus_pa()) c.missing(k + "youngs_modulus_pa", "Young's modulus (Pa), > 0");
+    else c.positive(k + "youngs_modulus_pa", mat.youngs_modulus_pa(), "Pa");
+    if (!mat.has_poisson_ratio()) c.missing(k + "poisson_ratio", "Poisson's ratio, in [0, 0.5)");
+    else if (!(mat.poisson_ratio() >= 0 && mat.poisson_ratio() < 0.5)) {
+      c.bad(k + "poisson_ratio", text(mat.poisson_ratio()), "a value in [0, 0.5)");
+    }
+    if (!mat.has_density_kg_m3()) c.missing(k + "density_kg_m3", "the density (kg/m^3), > 0");
+    else c.positive(k + "density_kg_m3", mat.density_kg_m3(), "kg/m^3");
+  }
+  if (m.regions_size() == 0) c.missing(key + "regions", "at least one region { material: .. rectangle { .. } }");
+  for (int i = 0; i < m.regions_size(); ++i) {
+    const auto& r = m.regions(i);
+    const std::string k = key + "regions[" + std::to_string(i) + "].";
+    if (!names.count(r.material())) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      c.bad(k + "material", "\"" + r.material() + "\"", "the name of a material: " + (list.empty() ? "(none)" : list));
+    }
+    switch (r.shape_case()) {
+      case scene::RegionSpec::kRectangle:
+        check_box(c, k + "rectangle", r.rectangle());
+        break;
+      case scene::RegionSpec::kPolygon:
+        if (r.polygon().x_m_size() < 3 || r.polygon().x_m_size() != r.polygon().y_m_size()) {
+          c.bad(k + "polygon", std::to_string(r.polygon().x_m_size()) + " x, " + std::to_string(r.polygon().y_m_size()) + " y",
+                "at least 3 vertices, as many x_m as y_m");
+        }
+        break;
+      case scene::RegionSpec::kLayer:
+        if (!(r.layer().y_max_m() > r.layer().y_min_m())) {
+          c.bad(k + "layer.y_max_m", text(r.layer().y_max_m()), "> y_min_m = " + text(r.layer().y_min_m()));
+        }
+        break;
+      case scene::RegionSpec::SHAPE_NOT_SET:
+        c.missing(k + "shape", "one of rectangle, polygon, layer");
+        break;
+    }
+    if (r.has_initial_stress()) {
+      const auto& s = r.initial_stress();
+      for (const auto& [name, v] : {std::pair{"xx_pa", s.xx_pa()}, std::pair{"yy_pa", s.yy_pa()},
+                                    std::pair{"xy_pa", s.xy_pa()}, std::pair{"zz_pa", s.zz_pa()}}) {
+        c.range(k + "initial_stress." + name, v, -kInf, kInf, false, "Pa");
+      }
+    }
+  }
+  if (m.particles_per_cell() < 1 || m.particles_per_cell() > 4) {
+    c.bad(key + "particles_per_cell", std::to_string(m.particles_per_cell()), "1, 2, 3 or 4 (per direction)");
+  }
+  c.range(key + "cfl", m.cfl(), 0, 1, true, "dt = cfl h / c_p; explicit MPM is unstable above 1");
+  c.range(key + "density_scaling", m.density_scaling(), 1, 1e12, false, "a factor >= 1");
+  for (int i = 0; i < m.constraints_size(); ++i) {
+    const auto& con = m.constraints(i);
+    const std::string k = key + "constraints[" + std::to_string(i) + "].";
+    const double h = m.cell_size_m();
+    if (con.has_symmetry_x_m() && h > 0 && !on_grid_line(con.symmetry_x_m(), m.grid().x_min_m(), h)) {
+      c.bad(k + "symmetry_x_m", text(con.symmetry_x_m()), "a grid line: x_min_m + k cell_size_m");
+    } else if (con.has_symmetry_y_m() && h > 0 && !on_grid_line(con.symmetry_y_m(), m.grid().y_min_m(), h)) {
+      c.bad(k + "symmetry_y_m", text(con.symmetry_y_m()), "a grid line: y_min_m + k cell_size_m");
+    } else if (con.has_fixed_box()) {
+      check_box(c, k + "fixed_box", con.fixed_box());
+    } else if (con.kind_case() == scene::ConstraintSpec::KIND_NOT_SET) {
+      c.missing(k + "kind", "one of symmetry_x_m, symmetry_y_m, fixed_box");
+    }
+  }
+  for (int i = 0; i < m.tractions_size(); ++i) {
+    const auto& t = m.tractions(i);
+    const std::string k = key + "tractions[" + std::to_string(i) + "].";
+    if (t.edge() == scene::EDGE_UNSPECIFIED) c.missing(k + "edge", "LEFT, RIGHT, BOTTOM or TOP");
+    if (!t.has_normal_pa() && !t.has_shear_pa()) c.missing(k + "normal_pa", "a normal and/or shear traction (Pa)");
+    if (t.has_normal_pa()) check_time_function(c, k + "normal_pa", t.normal_pa(), -kInf, "Pa");
+    if (t.has_shear_pa()) check_time_function(c, k + "shear_pa", t.shear_pa(), -kInf, "Pa");
+  }
+  for (int i = 0; i < m.silent_edges_size(); ++i) {
+    if (m.silent_edges(i) == scene::EDGE_UNSPECIFIED) {
+      c.bad(key + "silent_edges[" + std::to_string(i) + "]", "EDGE_UNSPECIFIED", "LEFT, RIGHT, BOTTOM or TOP");
+    }
+  }
+  c.non_negative(key + "damping.grid_alpha_per_s", m.damping().grid_alpha_per_s(), "1/s");
+  c.range(key + "damping.pic_fraction", m.damping().pic_fraction(), 0, 1, false, "0 (FLIP) to 1 (PIC)");
+  if (m.threads() < 1 || m.threads() > 64) c.bad(key + "threads", std::to_string(m.threads()), "1 to 64");
+}
+
+}  // namespace hfmpm::coupling
