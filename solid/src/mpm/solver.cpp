@@ -38,18 +38,28 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
     density_.push_back(rho);
   }
   const std::size_t n = config_.grid.node_count();
+  const bool cracked = !config_.cracks.empty();
+  for (std::size_t c = 0; c < config_.cracks.size(); ++c) {
+    cracks_.emplace_back(static_cast<std::uint32_t>(c), config_.cracks[c]);
+  }
   nodes_.resize(n);
   stamp_.assign(n, 0);
-  velocity_.assign(n, Vec2::Zero());
-  acceleration_.assign(n, Vec2::Zero());
+  const int fields = cracked ? 2 : 1;  // an uncracked body never touches field 1
+  for (int f = 0; f < fields; ++f) {
+    velocity_[f].assign(n, Vec2::Zero());
+    acceleration_[f].assign(n, Vec2::Zero());
+  }
   const int threads = std::max(1, config_.threads);
   thread_nodes_.resize(static_cast<std::size_t>(threads));
+  thread_second_.resize(static_cast<std::size_t>(threads));
   thread_touched_.resize(static_cast<std::size_t>(threads));
   thread_stamp_.resize(static_cast<std::size_t>(threads));
   for (int k = 0; k < threads; ++k) {
     thread_nodes_[static_cast<std::size_t>(k)].resize(n);
+    if (cracked) thread_second_[static_cast<std::size_t>(k)].resize(n);
     thread_stamp_[static_cast<std::size_t>(k)].assign(n, 0);
   }
+  if (cracked) second_.resize(n);
   generate_particles();
   build_constraints();
   find_edges();
@@ -85,6 +95,7 @@ void Solver::generate_particles() {
 void Solver::build_constraints() {
   const auto& g = config_.grid;
   const double tol = 1e-9 * g.h;
+  const bool cracked = !config_.cracks.empty();
   for (const auto& c : config_.constraints) {
     int count = 0;
     for (std::size_t n = 0; n < g.node_count(); ++n) {
@@ -98,6 +109,7 @@ void Solver::build_constraints() {
       }
       if (mask) {
         nodes_.fixed[n] |= mask;
+        if (cracked) second_.fixed[n] |= mask;
         ++count;
       }
     }
@@ -142,14 +154,25 @@ double Solver::kinetic_energy() const {
 
 void Solver::step(double dt) {
   ++epoch_;
-  p2g();
-  edge_loads();
-  grid_update(dt);
-  g2p(dt);
+  if (cracks_.empty()) {
+    p2g<false>();
+    edge_loads();
+    grid_update(dt);
+    g2p<false>(dt);
+  } else {
+    for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h);
+    p2g<true>();
+    edge_loads();
+    crack_loads();
+    grid_update(dt);
+    g2p<true>(dt);
+    move_crack_surfaces(dt);
+  }
   t_ += dt;
   ++steps_;
 }
 
+template <bool kCracks>
 void Solver::p2g() {
   const auto& g = config_.grid;
   const int threads = static_cast<int>(thread_nodes_.size());
@@ -158,7 +181,8 @@ void Solver::p2g() {
 #pragma omp parallel num_threads(threads)
   {
     const auto k = static_cast<std::size_t>(omp_get_thread_num());
-    auto& f = thread_nodes_[k];
+    auto& f0 = thread_nodes_[k];
+    auto& f1 = thread_second_[k];
     auto& touched = thread_touched_[k];
     auto& stamp = thread_stamp_[k];
     touched.clear();
@@ -173,6 +197,7 @@ void Solver::p2g() {
       const Vec2 mv = m * particles_.v[p];
       const Voigt& s = particles_.stress[p];
       const double vol = particles_.volume[p];
+      const bool near = kCracks && near_crack(particles_.x[p]);
       for (int b = 0; b < 3; ++b) {
         const int j = sy.first + b;
         if (j < 0 || j > g.ny) continue;
@@ -187,10 +212,16 @@ void Solver::p2g() {
           if (stamp[n] != epoch) {
             stamp[n] = epoch;
             touched.push_back(static_cast<int>(n));
-            f.mass[n] = 0;
-            f.momentum[n].setZero();
-            f.force[n].setZero();
+            f0.mass[n] = 0;
+            f0.momentum[n].setZero();
+            f0.force[n].setZero();
+            if constexpr (kCracks) {
+              f1.mass[n] = 0;
+              f1.momentum[n].setZero();
+              f1.force[n].setZero();
+            }
           }
+          auto& f = (near && field_of(particles_.x[p], g.position(static_cast<int>(n)))) ? f1 : f0;
           f.mass[n] += w * m;
           f.momentum[n] += w * mv;
           // internal force -V sigma . grad S (s = xx, yy, xy, zz)
@@ -201,21 +232,27 @@ void Solver::p2g() {
   }
   // Reduce the threads' fields into the active nodes.
   active_.clear();
+  auto merge = [&](NodalFields& to, const NodalFields& from, std::size_t u, bool first) {
+    if (first) {
+      to.mass[u] = from.mass[u];
+      to.momentum[u] = from.momentum[u];
+      to.force[u] = from.force[u];
+    } else {
+      to.mass[u] += from.mass[u];
+      to.momentum[u] += from.momentum[u];
+      to.force[u] += from.force[u];
+    }
+  };
   for (std::size_t k = 0; k < thread_nodes_.size(); ++k) {
-    const auto& f = thread_nodes_[k];
     for (int n : thread_touched_[k]) {
       const auto u = static_cast<std::size_t>(n);
-      if (stamp_[u] != epoch) {
+      const bool first = stamp_[u] != epoch;
+      if (first) {
         stamp_[u] = epoch;
         active_.push_back(n);
-        nodes_.mass[u] = f.mass[u];
-        nodes_.momentum[u] = f.momentum[u];
-        nodes_.force[u] = f.force[u];
-      } else {
-        nodes_.mass[u] += f.mass[u];
-        nodes_.momentum[u] += f.momentum[u];
-        nodes_.force[u] += f.force[u];
       }
+      merge(nodes_, thread_nodes_[k], u, first);
+      if constexpr (kCracks) merge(second_, thread_second_[k], u, first);
     }
   }
 }
@@ -244,7 +281,10 @@ void Solver::edge_loads() {
         if (!g.inside(i, j)) continue;
         const auto node = static_cast<std::size_t>(g.node(i, j));
         if (stamp_[node] != epoch_) continue;  // no mass there: nothing to push
-        nodes_.force[node] += w * force;
+        // Near a crack the force goes to the field of the particle's side.
+        const bool other = !cracks_.empty() && near_crack(particles_.x[p]) &&
+                           field_of(particles_.x[p], g.position(static_cast<int>(node)));
+        (other ? second_ : nodes_).force[node] += w * force;
       }
     }
   };
@@ -272,24 +312,31 @@ void Solver::edge_loads() {
 
 void Solver::grid_update(double dt) {
   const double alpha = config_.damping.grid_alpha;
-  for (int n : active_) {
-    const auto u = static_cast<std::size_t>(n);
-    const double m = nodes_.mass[u];
-    if (m <= min_mass_) {
-      velocity_[u].setZero();
-      acceleration_[u].setZero();
-      continue;
+  const int fields = cracks_.empty() ? 1 : 2;
+  for (int field = 0; field < fields; ++field) {
+    const NodalFields& nodes = field ? second_ : nodes_;
+    auto& velocity = velocity_[field];
+    auto& acceleration = acceleration_[field];
+    for (int n : active_) {
+      const auto u = static_cast<std::size_t>(n);
+      const double m = nodes.mass[u];
+      if (m <= min_mass_) {
+        velocity[u].setZero();
+        acceleration[u].setZero();
+        continue;
+      }
+      Vec2 f = nodes.force[u] - alpha * nodes.momentum[u];
+      Vec2 p = nodes.momentum[u] + dt * f;
+      const std::uint8_t fixed = nodes.fixed[u];
+      if (fixed & 1) f.x() = p.x() = 0;
+      if (fixed & 2) f.y() = p.y() = 0;
+      velocity[u] = p / m;
+      acceleration[u] = f / m;
     }
-    Vec2 f = nodes_.force[u] - alpha * nodes_.momentum[u];
-    Vec2 p = nodes_.momentum[u] + dt * f;
-    const std::uint8_t fixed = nodes_.fixed[u];
-    if (fixed & 1) f.x() = p.x() = 0;
-    if (fixed & 2) f.y() = p.y() = 0;
-    velocity_[u] = p / m;
-    acceleration_[u] = f / m;
   }
 }
 
+template <bool kCracks>
 void Solver::g2p(double dt) {
   const auto& g = config_.grid;
   const double pic = config_.damping.pic_fraction;
@@ -303,6 +350,7 @@ void Solver::g2p(double dt) {
     const double lp = particles_.half_size[p];
     const auto sx = ugimp_stencil(rel.x(), g.h, lp);
     const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+    const bool near = kCracks && near_crack(particles_.x[p]);
     Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
     double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
     for (int b = 0; b < 3; ++b) {
@@ -316,9 +364,10 @@ void Solver::g2p(double dt) {
         const double gx = sx.g[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
         const double gy = sx.s[static_cast<std::size_t>(c)] * sy.g[static_cast<std::size_t>(b)];
         const auto n = static_cast<std::size_t>(g.node(i, j));
-        const Vec2& vn = velocity_[n];
+        const int field = near ? field_of(particles_.x[p], g.position(static_cast<int>(n))) : 0;
+        const Vec2& vn = velocity_[field][n];
         v_new += w * vn;
-        a += w * acceleration_[n];
+        a += w * acceleration_[field][n];
         l00 += vn.x() * gx;
         l01 += vn.x() * gy;
         l10 += vn.y() * gx;
@@ -350,6 +399,11 @@ void Solver::g2p(double dt) {
     throw std::runtime_error(out.str());
   }
 }
+
+template void Solver::p2g<false>();
+template void Solver::p2g<true>();
+template void Solver::g2p<false>(double);
+template void Solver::g2p<true>(double);
 
 bool Region::contains(const Vec2& p) const {
   switch (kind) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "hfmpm/solid/mpm/crack.hpp"
 #include "hfmpm/solid/mpm/grid.hpp"
 #include "hfmpm/solid/mpm/material.hpp"
 #include "hfmpm/solid/mpm/particles.hpp"
@@ -64,6 +65,7 @@ struct SolidConfig {
   std::vector<Traction> tractions;
   std::vector<Edge> silent_edges;  // absorbing (dashpot) edges
   Damping damping;
+  std::vector<CrackSpec> cracks;
   int threads = 1;
 };
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "hfmpm/solid/mpm/config.hpp"
+#include "hfmpm/solid/mpm/crack.hpp"
 #include "hfmpm/solid/mpm/grid.hpp"
 #include "hfmpm/solid/mpm/particles.hpp"
 
@@ -42,26 +43,45 @@ class Solver {
   const std::vector<std::uint32_t>& edge_particles(Edge edge) const {
     return edges_[static_cast<std::size_t>(edge)];
   }
+  std::vector<Crack>& cracks() { return cracks_; }
+  const std::vector<Crack>& cracks() const { return cracks_; }
+  // The nodal fields of one side of a crack: field 1 holds the particles whose
+  // line to the node crosses a crack (only near cracks).
+  const NodalFields& nodes(int field) const { return field ? second_ : nodes_; }
+  // 1 if the segment from `from` to `node` crosses a crack an odd number of times.
+  int field_of_public(const Vec2& from, const Vec2& node) const { return field_of(from, node); }
+  // Crack-face pressure, Pa, per crack particle of crack c (resized to the crack).
+  void set_crack_pressure(std::size_t c, const std::vector<double>& pressure);
 
  private:
   void generate_particles();
   void build_constraints();
   void find_edges();
+  template <bool kCracks>
   void p2g();
   void edge_loads();
   void grid_update(double dt);
+  template <bool kCracks>
   void g2p(double dt);
+  // Cracks (solver_cracks.cpp)
+  bool near_crack(const Vec2& x) const;
+  int field_of(const Vec2& from, const Vec2& node) const;  // 1 if the line crosses a crack
+  void crack_loads();
+  void move_crack_surfaces(double dt);
 
   SolidConfig config_;
   Particles particles_;
-  NodalFields nodes_;                 // reduced fields
+  NodalFields nodes_;                 // reduced fields, field 0
+  NodalFields second_;                // field 1 (other side of a crack); sized only with cracks
+  std::vector<Crack> cracks_;
   std::vector<NodalFields> thread_nodes_;
+  std::vector<NodalFields> thread_second_;
   std::vector<std::vector<int>> thread_touched_;
   std::vector<std::vector<std::uint32_t>> thread_stamp_;
   std::vector<std::uint32_t> stamp_;
   std::vector<int> active_;
-  std::vector<Vec2> velocity_;        // new nodal velocity, per node
-  std::vector<Vec2> acceleration_;    // nodal acceleration, per node
+  std::vector<Vec2> velocity_[2];     // new nodal velocity, per field and node
+  std::vector<Vec2> acceleration_[2]; // nodal acceleration, per field and node
   std::vector<std::uint32_t> edges_[4];
   std::vector<double> lambda_, shear_, p_modulus_, density_;  // per material, density scaled
   std::uint32_t epoch_ = 0;

@@ -1,0 +1,69 @@
+// An explicit crack (CRAMP; Nairn 2003, "Material point method calculations
+// with explicit cracks", CMES 4(6); Guo and Nairn 2004): a chain of massless
+// crack particles joined by segments. Each particle has a position on the
+// crack plane and two surface positions, above and below. "Above" is the
+// left of the direction from the first particle to the last.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "hfmpm/exchange.hpp"
+
+namespace hfmpm::solid::mpm {
+
+struct CrackSpec {
+  std::vector<Vec2> points;   // initial crack particles, in order; at least 2
+  bool start_is_tip = false;  // false: the first particle is a mouth on the body's edge
+  bool end_is_tip = true;
+};
+
+class Crack {
+ public:
+  Crack(std::uint32_t id, const CrackSpec& spec);
+
+  std::uint32_t id() const { return id_; }
+  std::size_t size() const { return plane_.size(); }
+  const std::vector<Vec2>& plane() const { return plane_; }
+  const std::vector<Vec2>& surface(int side) const { return side > 0 ? above_ : below_; }
+  std::vector<Vec2>& surface(int side) { return side > 0 ? above_ : below_; }
+  const std::vector<std::uint64_t>& ids() const { return ids_; }
+  std::vector<double>& pressure() { return pressure_; }
+  const std::vector<double>& pressure() const { return pressure_; }
+  bool start_is_tip() const { return start_is_tip_; }
+  bool end_is_tip() const { return end_is_tip_; }
+
+  // Unit normal at particle k: the mean of the left normals of its segments.
+  Vec2 normal(std::size_t k) const;
+  // Length the particle stands for: half the distance to each neighbour.
+  double tributary_length(std::size_t k) const;
+  // Opening (x_above - x_below) . n, never negative.
+  double width(std::size_t k) const;
+
+  // Before each step: segment bounding boxes; `extension` is how far a mouth
+  // (non-tip) end is extended beyond the body for the side tests.
+  void prepare(double extension);
+  // Parity of crossings of the segment p-q with the crack (extended at mouths).
+  bool crosses(const Vec2& p, const Vec2& q) const;
+  // Axis-aligned box around the crack (with extensions), grown by `margin`.
+  bool near(const Vec2& p, double margin) const;
+
+  // Crack plane = midpoint of the surfaces (after the surfaces moved).
+  void update_plane();
+
+  // Appends a crack particle at the end (growth); it starts closed.
+  void append(const Vec2& position);
+
+ private:
+  std::uint32_t id_;
+  bool start_is_tip_, end_is_tip_;
+  std::vector<std::uint64_t> ids_;
+  std::vector<Vec2> plane_, above_, below_;
+  std::vector<double> pressure_;  // Pa, on the faces, per crack particle
+  std::uint64_t next_id_ = 0;
+  // Side-test geometry: the plane polyline with extended mouth ends.
+  std::vector<Vec2> path_;
+  Vec2 lo_ = Vec2::Zero(), hi_ = Vec2::Zero();
+};
+
+}  // namespace hfmpm::solid::mpm

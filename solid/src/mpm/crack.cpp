@@ -1,0 +1,86 @@
+#include "hfmpm/solid/mpm/crack.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "hfmpm/solid/mpm/predicates.hpp"
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+Vec2 left_normal(const Vec2& a, const Vec2& b) {
+  const Vec2 d = (b - a).normalized();
+  return {-d.y(), d.x()};
+}
+
+}  // namespace
+
+Crack::Crack(std::uint32_t id, const CrackSpec& spec)
+    : id_(id), start_is_tip_(spec.start_is_tip), end_is_tip_(spec.end_is_tip) {
+  if (spec.points.size() < 2) throw std::invalid_argument("a crack needs at least 2 points");
+  for (const auto& p : spec.points) append(p);
+}
+
+void Crack::append(const Vec2& position) {
+  ids_.push_back(next_id_++);
+  plane_.push_back(position);
+  above_.push_back(position);
+  below_.push_back(position);
+  pressure_.push_back(0.0);
+}
+
+Vec2 Crack::normal(std::size_t k) const {
+  Vec2 n = Vec2::Zero();
+  if (k > 0) n += left_normal(plane_[k - 1], plane_[k]);
+  if (k + 1 < plane_.size()) n += left_normal(plane_[k], plane_[k + 1]);
+  return n.normalized();
+}
+
+double Crack::tributary_length(std::size_t k) const {
+  double l = 0;
+  if (k > 0) l += 0.5 * (plane_[k] - plane_[k - 1]).norm();
+  if (k + 1 < plane_.size()) l += 0.5 * (plane_[k + 1] - plane_[k]).norm();
+  return l;
+}
+
+double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(normal(k))); }
+
+void Crack::prepare(double extension) {
+  path_.clear();
+  const std::size_t n = plane_.size();
+  if (!start_is_tip_) path_.push_back(plane_[0] - extension * (plane_[1] - plane_[0]).normalized());
+  path_.insert(path_.end(), plane_.begin(), plane_.end());
+  if (!end_is_tip_) path_.push_back(plane_[n - 1] + extension * (plane_[n - 1] - plane_[n - 2]).normalized());
+  lo_ = hi_ = path_.front();
+  for (const auto& p : path_) {
+    lo_ = lo_.cwiseMin(p);
+    hi_ = hi_.cwiseMax(p);
+  }
+}
+
+bool Crack::near(const Vec2& p, double margin) const {
+  return p.x() >= lo_.x() - margin && p.x() <= hi_.x() + margin && p.y() >= lo_.y() - margin &&
+         p.y() <= hi_.y() + margin;
+}
+
+bool Crack::crosses(const Vec2& p, const Vec2& q) const {
+  const Vec2 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
+  bool odd = false;
+  for (std::size_t s = 0; s + 1 < path_.size(); ++s) {
+    const Vec2& a = path_[s];
+    const Vec2& b = path_[s + 1];
+    // Cheap rejection by bounding boxes before the exact test.
+    if (std::max(a.x(), b.x()) < lo.x() || std::min(a.x(), b.x()) > hi.x() || std::max(a.y(), b.y()) < lo.y() ||
+        std::min(a.y(), b.y()) > hi.y()) {
+      continue;
+    }
+    if (segments_cross(p, q, a, b)) odd = !odd;
+  }
+  return odd;
+}
+
+void Crack::update_plane() {
+  for (std::size_t k = 0; k < plane_.size(); ++k) plane_[k] = 0.5 * (above_[k] + below_[k]);
+}
+
+}  // namespace hfmpm::solid::mpm

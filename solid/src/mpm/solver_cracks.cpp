@@ -1,0 +1,125 @@
+// The crack parts of the MPM step (CRAMP): which velocity field a
+// particle-node pair uses, crack-face pressure into each side's field, and
+// the crack surfaces moved by their own side's field.
+#include <cmath>
+
+#include "hfmpm/solid/mpm/shape.hpp"
+#include "hfmpm/solid/mpm/solver.hpp"
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+// The 4 nodes of the cell holding x and their linear weights.
+struct CellWeights {
+  int i = 0, j = 0;
+  double w[2][2] = {{0, 0}, {0, 0}};  // [a][b] for node (i + a, j + b)
+};
+
+CellWeights cell_weights(const Grid& g, const Vec2& x) {
+  CellWeights c;
+  const Vec2 rel = (x - g.origin) / g.h;
+  c.i = static_cast<int>(std::floor(rel.x()));
+  c.j = static_cast<int>(std::floor(rel.y()));
+  const double fx = rel.x() - c.i, fy = rel.y() - c.j;
+  c.w[0][0] = (1 - fx) * (1 - fy);
+  c.w[1][0] = fx * (1 - fy);
+  c.w[0][1] = (1 - fx) * fy;
+  c.w[1][1] = fx * fy;
+  return c;
+}
+
+}  // namespace
+
+bool Solver::near_crack(const Vec2& x) const {
+  // A particle-node segment is at most about 2.2 h long (uGIMP reach).
+  const double margin = 2.5 * config_.grid.h;
+  for (const auto& crack : cracks_) {
+    if (crack.near(x, margin)) return true;
+  }
+  return false;
+}
+
+int Solver::field_of(const Vec2& from, const Vec2& node) const {
+  bool odd = false;
+  for (const auto& crack : cracks_) {
+    if (crack.crosses(from, node)) odd = !odd;  // an even number of crossings cancels
+  }
+  return odd ? 1 : 0;
+}
+
+// For side `side` (+1 above, -1 below) of crack particle k: the nodes around
+// the surface point, the field that side uses at each, and linear weights
+// over the nodes where that field has mass (renormalized).
+template <class Visit>
+void for_side_nodes(const Solver& solver, const Grid& g, const NodalFields* fields[2], const Crack& crack,
+                    std::size_t k, int side, double min_mass, Visit&& visit) {
+  const Vec2 n = crack.normal(k);
+  const Vec2 test = crack.plane()[k] + side * 1e-6 * g.h * n;  // a point just off the plane on that side
+  const auto cell = cell_weights(g, crack.surface(side)[k]);
+  int node[4], field[4];
+  double weight[4], total = 0;
+  int count = 0;
+  for (int a = 0; a < 2; ++a) {
+    for (int b = 0; b < 2; ++b) {
+      if (!g.inside(cell.i + a, cell.j + b)) continue;
+      const int nd = g.node(cell.i + a, cell.j + b);
+      const int f = solver.field_of_public(test, g.position(nd));
+      const double w = cell.w[a][b];
+      if (w <= 0 || fields[f]->mass[static_cast<std::size_t>(nd)] <= min_mass) continue;
+      node[count] = nd;
+      field[count] = f;
+      weight[count] = w;
+      total += w;
+      ++count;
+    }
+  }
+  for (int c = 0; c < count; ++c) visit(node[c], field[c], weight[c] / total);
+}
+
+void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressure) {
+  auto& target = cracks_.at(c).pressure();
+  for (std::size_t k = 0; k < target.size(); ++k) target[k] = k < pressure.size() ? pressure[k] : 0.0;
+}
+
+void Solver::crack_loads() {
+  const auto& g = config_.grid;
+  const NodalFields* fields[2] = {&nodes_, &second_};
+  for (const auto& crack : cracks_) {
+    for (std::size_t k = 0; k < crack.size(); ++k) {
+      const double p = crack.pressure()[k];
+      if (p == 0) continue;
+      // Pressure opens the crack: +n into the field above, -n into the field below.
+      const Vec2 force = p * crack.tributary_length(k) * crack.normal(k);
+      for (int side : {1, -1}) {
+        for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
+          (f ? second_ : nodes_).force[static_cast<std::size_t>(nd)] += side * w * force;
+        });
+      }
+    }
+  }
+}
+
+void Solver::move_crack_surfaces(double dt) {
+  const auto& g = config_.grid;
+  const NodalFields* fields[2] = {&nodes_, &second_};
+  for (auto& crack : cracks_) {
+    for (int side : {1, -1}) {
+      std::vector<Vec2> velocity(crack.size(), Vec2::Zero());
+      for (std::size_t k = 0; k < crack.size(); ++k) {
+        // Mass-weighted velocity of the side's own field.
+        double mass = 0;
+        Vec2 momentum = Vec2::Zero();
+        for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
+          const double m = fields[f]->mass[static_cast<std::size_t>(nd)];
+          mass += w * m;
+          momentum += w * m * velocity_[f][static_cast<std::size_t>(nd)];
+        });
+        if (mass > 0) velocity[k] = momentum / mass;
+      }
+      for (std::size_t k = 0; k < crack.size(); ++k) crack.surface(side)[k] += dt * velocity[k];
+    }
+    crack.update_plane();
+  }
+}
+
+}  // namespace hfmpm::solid::mpm

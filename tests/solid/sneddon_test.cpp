@@ -1,0 +1,104 @@
+// Sneddon's pressurised centre crack (length 2a, faces loaded by p) in a box
+// of half-width b = 5a, modelled as a half body with a symmetry plane through
+// the crack centre (x = 0), explicit CRAMP crack from x = 0 to the tip x = a.
+// Reference (Sneddon 1946; Tada, Paris and Irwin, The Stress Analysis of
+// Cracks Handbook): w(x) = 4 p / E' sqrt(a^2 - x^2), E' = E / (1 - nu^2),
+// scaled by the finite-width factor of a centre crack in a strip of width 2b
+// with free edges, F = (1 - 0.025 al^2 + 0.06 al^4) sqrt(sec(pi al / 2)),
+// al = a / b (Tada's fit, 0.1%): F = 1.0245 at b = 5a.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <numbers>
+
+#include "hfmpm/solid/mpm/solver.hpp"
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+constexpr double kA = 1.0, kB = 5.0, kP = 1e6;
+const Material kRock{"rock", 1e10, 0.25, 2500};
+
+double finite_width_factor(double a, double b) {
+  const double al = a / b;
+  return (1 - 0.025 * al * al + 0.06 * std::pow(al, 4)) * std::sqrt(1 / std::cos(std::numbers::pi * al / 2));
+}
+
+struct SneddonResult {
+  double l2_error = 0;       // relative L2 error of the opening profile
+  double mouth_error = 0;    // relative error of the opening at x = 0
+  std::size_t particles = 0;
+  std::uint64_t steps = 0;
+};
+
+SneddonResult run_sneddon(int cells_per_a, int threads) {
+  const double h = kA / cells_per_a;
+  SolidConfig c;
+  c.grid.origin = Vec2(0, -kB - 2 * h);
+  c.grid.h = h;
+  c.grid.nx = static_cast<int>(std::lround(kB / h)) + 2;
+  c.grid.ny = static_cast<int>(std::lround(2 * kB / h)) + 4;
+  c.materials = {kRock};
+  Region r;
+  r.lo = Vec2(0, -kB);
+  r.hi = Vec2(kB, kB);
+  c.regions = {r};
+  c.constraints = {{Constraint::Kind::PlaneX, 0.0}};
+  CrackSpec crack;
+  const int segments = 2 * cells_per_a;  // crack particles every half cell
+  for (int k = 0; k <= segments; ++k) crack.points.emplace_back(kA * k / segments, 0.0);
+  crack.start_is_tip = false;  // the crack centre, on the symmetry plane
+  crack.end_is_tip = true;
+  c.cracks = {crack};
+  // Damping near critical for the lowest modes of the box.
+  const double c_p = kRock.p_wave_speed(kRock.density);
+  c.damping.grid_alpha = 2 * std::numbers::pi * c_p / (4 * kB);
+  c.threads = threads;
+  Solver solid(c);
+  solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), kP));
+  const double dt = solid.stable_dt();
+  const double transit = 2 * kB / c_p;
+  while (solid.time() < 12 * transit) solid.step(dt);
+
+  const double e_prime = kRock.plane_strain_modulus();
+  const double factor = finite_width_factor(kA, kB);
+  const auto& cr = solid.cracks()[0];
+  double num = 0, den = 0;
+  for (std::size_t k = 0; k < cr.size(); ++k) {
+    const double x = kA * static_cast<double>(k) / segments;
+    const double exact = factor * 4 * kP / e_prime * std::sqrt(std::max(0.0, kA * kA - x * x));
+    num += std::pow(cr.width(k) - exact, 2);
+    den += exact * exact;
+  }
+  SneddonResult result;
+  result.l2_error = std::sqrt(num / den);
+  const double mouth = factor * 4 * kP * kA / e_prime;
+  result.mouth_error = (cr.width(0) - mouth) / mouth;
+  result.particles = solid.particles().size();
+  result.steps = solid.steps();
+  return result;
+}
+
+// CI size: h = a/5 and a/10. The error falls at first order (the square-root
+// tip is resolved by a few cells); measured 9.7% and 4.8%, so a/10 is held to
+// 6% and the mouth opening to 2%. The a/20 figure is in docs/verification.md.
+TEST(Sneddon, OpeningProfileMatchesAndConverges) {
+  const int finest = std::getenv("HFMPM_SNEDDON_CELLS") ? std::atoi(std::getenv("HFMPM_SNEDDON_CELLS")) : 10;
+  double previous = 1;
+  for (int cells = 5; cells <= finest; cells *= 2) {
+    const auto r = run_sneddon(cells, 2);
+    std::printf("sneddon h = a/%d: %zu particles, %llu steps, opening L2 error %.4f, mouth error %+.4f\n", cells,
+                r.particles, static_cast<unsigned long long>(r.steps), r.l2_error, r.mouth_error);
+    EXPECT_LT(r.l2_error, 0.8 * previous) << "no convergence at h = a/" << cells;
+    if (cells >= 10) {
+      EXPECT_LT(r.l2_error, 0.06);
+      EXPECT_LT(std::abs(r.mouth_error), 0.02);
+    }
+    previous = r.l2_error;
+  }
+}
+
+}  // namespace
+}  // namespace hfmpm::solid::mpm
