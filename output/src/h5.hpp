@@ -1,0 +1,44 @@
+// A thin checked layer over the HDF5 C API for FrameWriter: one writable file, objects addressed by absolute
+// path. Every HDF5 call is checked; a failure throws std::runtime_error naming the file, the object, what
+// failed and HDF5's innermost error message. HDF5's automatic error printing is muted during these calls.
+#pragma once
+
+#include <hdf5.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hfmpm::output::h5 {
+
+class File {
+ public:
+  // Creates the file, truncating an existing one.
+  explicit File(const std::string& path);
+  ~File();
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
+
+  void create_group(const std::string& object);
+  // Datasets of the given dimensions (row-major); data may be null when a dimension is 0.
+  void write_f64(const std::string& object, const std::vector<hsize_t>& dims, const double* data);
+  void write_i32(const std::string& object, const std::vector<hsize_t>& dims, const std::int32_t* data);
+  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
+  void set_attribute(const std::string& object, const std::string& name, double value);
+  void set_attribute(const std::string& object, const std::string& name, std::uint64_t value);
+  void set_attribute(const std::string& object, const std::string& name, const std::string& value);
+  // Writes everything buffered by HDF5 to the file.
+  void flush();
+  const std::string& path() const { return path_; }
+
+ private:
+  void write_dataset(const std::string& object, const std::vector<hsize_t>& dims, hid_t file_type, hid_t mem_type,
+                     const void* data);
+  void write_attribute(const std::string& object, const std::string& name, hid_t file_type, hid_t mem_type,
+                       const void* data);
+
+  std::string path_;
+  hid_t id_ = -1;
+};
+
+}  // namespace hfmpm::output::h5
