@@ -15,3 +15,9 @@ endif()
 # hfmpm_options: warnings + sanitizers, for project code (not generated code).
 add_library(hfmpm_options INTERFACE)
 target_link_libraries(hfmpm_options INTERFACE hfmpm_warnings hfmpm_sanitize)
+
+# GCC 12 reports -Wrestrict inside libstdc++'s std::string at -O3 for ordinary
+# string concatenation (GCC bug 105651, a false positive); keep the rest.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(hfmpm_warnings INTERFACE -Wno-restrict)
+endif()

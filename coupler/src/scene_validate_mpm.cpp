@@ -131,6 +131,16 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
       c.bad(key + "silent_edges[" + std::to_string(i) + "]", "EDGE_UNSPECIFIED", "LEFT, RIGHT, BOTTOM or TOP");
     }
   }
+  for (int i = 0; i < m.cracks_size(); ++i) {
+    const auto& cr = m.cracks(i);
+    const std::string k = key + "cracks[" + std::to_string(i) + "].";
+    if (cr.x_m_size() < 2 || cr.x_m_size() != cr.y_m_size()) {
+      c.bad(k + "x_m", std::to_string(cr.x_m_size()) + " x, " + std::to_string(cr.y_m_size()) + " y",
+            "at least 2 vertices, as many x_m as y_m");
+    }
+    if (cr.has_spacing_m()) c.range(k + "spacing_m", cr.spacing_m(), 0, m.cell_size_m(), true, "m, at most one cell");
+    if (cr.has_pressure_pa()) check_time_function(c, k + "pressure_pa", cr.pressure_pa(), 0.0, "Pa");
+  }
   c.non_negative(key + "damping.grid_alpha_per_s", m.damping().grid_alpha_per_s(), "1/s");
   c.range(key + "damping.pic_fraction", m.damping().pic_fraction(), 0, 1, false, "0 (FLIP) to 1 (PIC)");
   if (m.threads() < 1 || m.threads() > 64) c.bad(key + "threads", std::to_string(m.threads()), "1 to 64");

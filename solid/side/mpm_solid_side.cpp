@@ -1,10 +1,12 @@
 #include "mpm_solid_side.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <map>
 #include <optional>
 
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/output/frame_writer.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
 
 namespace hfmpm::solid {
@@ -24,33 +26,112 @@ mpm::Edge to_edge(scene::Edge e) {
 
 class MpmSolidSide final : public coupling::SideModel {
  public:
-  void setup(const scene::Scene& scene, const std::string& /*output_dir*/) override {
+  void setup(const scene::Scene& scene, const std::string& output_dir) override {
     if (!scene.solid().has_mpm()) throw coupling::InputError("this side runs solid.mpm scenes only");
     try {
       solver_.emplace(to_solid_config(scene.solid().mpm()));
     } catch (const std::invalid_argument& e) {
       throw coupling::InputError(std::string("solid.mpm: ") + e.what());
     }
+    // Without a fluid, a crack may carry a prescribed face pressure.
+    for (const auto& crack : scene.solid().mpm().cracks()) {
+      prescribed_.push_back(!scene.has_fluid() && crack.has_pressure_pa()
+                                ? std::optional<TimeFunction>(proto::to_time_function(crack.pressure_pa()))
+                                : std::nullopt);
+    }
+    if (scene.output().hdf5()) {
+      writer_.emplace(output_dir + "/solid.h5", "hfmpm solid: " + scene.name());
+      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+    }
   }
   double stable_dt() const override { return solver_->stable_dt(); }
-  void advance(double dt) override { solver_->step(dt); }
+  void advance(double dt) override {
+    for (std::size_t c = 0; c < prescribed_.size(); ++c) {
+      if (!prescribed_[c]) continue;
+      const double p = (*prescribed_[c])(solver_->time());
+      solver_->set_crack_pressure(c, std::vector<double>(solver_->cracks()[c].size(), p));
+    }
+    solver_->step(dt);
+  }
   void publish(protocol::DataFrame& frame) override {
-    frame.mutable_crack();  // no crack yet: an empty CrackState
+    auto* state = frame.mutable_crack();
+    for (const auto& crack : solver_->cracks()) proto::to_proto(geometry(crack), state->add_cracks());
   }
   void receive(const protocol::DataFrame& frame) override {
-    if (frame.fluid().cracks_size() > 0) {
-      throw proto::ProtocolError("FluidState has pressures for " + std::to_string(frame.fluid().cracks_size()) +
-                                 " crack(s) but this solid has no crack");
+    for (const auto& c : frame.fluid().cracks()) {
+      if (c.crack_id() >= solver_->cracks().size()) {
+        throw proto::ProtocolError("FluidState names crack " + std::to_string(c.crack_id()) + "; this solid has " +
+                                   std::to_string(solver_->cracks().size()) + " crack(s)");
+      }
+      const auto pressure = proto::from_proto(c);
+      const auto& ids = solver_->cracks()[c.crack_id()].ids();
+      if (pressure.size() > ids.size() || !std::equal(pressure.ids.begin(), pressure.ids.end(), ids.begin())) {
+        throw proto::ProtocolError("FluidState crack " + std::to_string(c.crack_id()) +
+                                   ": its ids must be the crack's ids in order (a prefix while the crack grows)");
+      }
+      solver_->set_crack_pressure(c.crack_id(), pressure.pressure);
     }
   }
   SideDiagnostics diagnostics() const override {
     SideDiagnostics d;
     d.kinetic_energy = solver_->kinetic_energy();
+    if (!solver_->cracks().empty()) {
+      const auto& crack = solver_->cracks().front();
+      const auto s = arc_length(crack.plane());
+      d.crack_length = s.back();
+      d.mouth_opening = crack.width(0);
+      for (std::size_t k = 0; k < crack.size(); ++k) d.crack_face_load += crack.pressure()[k] * crack.tributary_length(k);
+    }
+    for (const auto& crack : solver_->cracks()) d.crack_particles += static_cast<std::uint32_t>(crack.size());
     return d;
+  }
+  void write_output(std::uint64_t /*frame*/, double t) override {
+    if (!writer_) return;
+    const auto& p = solver_->particles();
+    writer_->begin_frame(t, solver_->steps());
+    writer_->points("particles", p.x);
+    writer_->vector("particles", "velocity", p.v);
+    writer_->tensor("particles", "stress", p.stress);
+    writer_->integer("particles", "material", p.material);
+    for (const auto& crack : solver_->cracks()) {
+      const std::string set = "crack" + std::to_string(crack.id());
+      std::vector<double> width(crack.size());
+      std::vector<Vec2> normal(crack.size());
+      for (std::size_t k = 0; k < crack.size(); ++k) {
+        width[k] = crack.width(k);
+        normal[k] = crack.normal(k);
+      }
+      writer_->points(set, crack.plane());
+      writer_->scalar(set, "width", width);
+      writer_->scalar(set, "pressure", crack.pressure());
+      writer_->vector(set, "normal", normal);
+      writer_->points(set + "_above", crack.surface(1));
+      writer_->points(set + "_below", crack.surface(-1));
+    }
+    writer_->end_frame();
   }
 
  private:
+  static CrackGeometry geometry(const mpm::Crack& crack) {
+    CrackGeometry g;
+    g.crack_id = crack.id();
+    g.ids = crack.ids();
+    g.position = crack.plane();
+    g.normal.resize(crack.size());
+    g.width.resize(crack.size());
+    g.tip.assign(crack.size(), 0);
+    for (std::size_t k = 0; k < crack.size(); ++k) {
+      g.normal[k] = crack.normal(k);
+      g.width[k] = crack.width(k);
+    }
+    if (crack.start_is_tip()) g.tip.front() = 1;
+    if (crack.end_is_tip()) g.tip.back() = 1;
+    return g;
+  }
+
   std::optional<mpm::Solver> solver_;
+  std::vector<std::optional<TimeFunction>> prescribed_;
+  std::optional<output::FrameWriter> writer_;
 };
 
 }  // namespace
@@ -119,6 +200,20 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   c.damping.grid_alpha = s.damping().grid_alpha_per_s();
   c.damping.pic_fraction = s.damping().pic_fraction();
   c.threads = static_cast<int>(s.threads());
+  for (const auto& cr : s.cracks()) {
+    mpm::CrackSpec spec;
+    spec.start_is_tip = cr.start_is_tip();
+    spec.end_is_tip = cr.end_is_tip();
+    const double spacing = cr.has_spacing_m() ? cr.spacing_m() : h / 2;
+    // Resample each polyline segment into pieces no longer than the spacing.
+    spec.points.emplace_back(cr.x_m(0), cr.y_m(0));
+    for (int i = 1; i < cr.x_m_size(); ++i) {
+      const Vec2 a(cr.x_m(i - 1), cr.y_m(i - 1)), b(cr.x_m(i), cr.y_m(i));
+      const int pieces = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing - 1e-9)));
+      for (int k = 1; k <= pieces; ++k) spec.points.push_back(a + (b - a) * (static_cast<double>(k) / pieces));
+    }
+    c.cracks.push_back(spec);
+  }
   return c;
 }
 
