@@ -103,20 +103,38 @@ void Solver::move_crack_surfaces(double dt) {
   const auto& g = config_.grid;
   const NodalFields* fields[2] = {&nodes_, &second_};
   for (auto& crack : cracks_) {
-    for (int side : {1, -1}) {
-      std::vector<Vec2> velocity(crack.size(), Vec2::Zero());
-      for (std::size_t k = 0; k < crack.size(); ++k) {
+    const std::size_t count = crack.size();
+    std::vector<Vec2> momentum[2];
+    std::vector<double> mass[2];
+    for (int s = 0; s < 2; ++s) {
+      const int side = s == 0 ? 1 : -1;
+      momentum[s].assign(count, Vec2::Zero());
+      mass[s].assign(count, 0.0);
+      for (std::size_t k = 0; k < count; ++k) {
         // Mass-weighted velocity of the side's own field.
-        double mass = 0;
-        Vec2 momentum = Vec2::Zero();
         for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
           const double m = fields[f]->mass[static_cast<std::size_t>(nd)];
-          mass += w * m;
-          momentum += w * m * velocity_[f][static_cast<std::size_t>(nd)];
+          mass[s][k] += w * m;
+          momentum[s][k] += w * m * velocity_[f][static_cast<std::size_t>(nd)];
         });
-        if (mass > 0) velocity[k] = momentum / mass;
       }
-      for (std::size_t k = 0; k < crack.size(); ++k) crack.surface(side)[k] += dt * velocity[k];
+    }
+    // The faces meet at a tip: both surfaces of a tip particle move together.
+    auto close_tip = [&](std::size_t k) {
+      const double m = mass[0][k] + mass[1][k];
+      const Vec2 p = momentum[0][k] + momentum[1][k];
+      for (int s = 0; s < 2; ++s) {
+        momentum[s][k] = p;
+        mass[s][k] = m;
+      }
+    };
+    if (crack.start_is_tip()) close_tip(0);
+    if (crack.end_is_tip()) close_tip(count - 1);
+    for (int s = 0; s < 2; ++s) {
+      auto& surface = crack.surface(s == 0 ? 1 : -1);
+      for (std::size_t k = 0; k < count; ++k) {
+        if (mass[s][k] > 0) surface[k] += dt * momentum[s][k] / mass[s][k];
+      }
     }
     crack.update_plane();
   }
