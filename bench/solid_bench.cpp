@@ -35,6 +35,56 @@ SolidConfig block(int cells, int threads) {
   return c;
 }
 
+// Sneddon's set-up (bench only): half box 5a x 10a, crack from the symmetry
+// plane to x = a with uniform face pressure, h = a / cells_per_a.
+SolidConfig cracked(int cells_per_a, int threads) {
+  SolidConfig c;
+  const double h = 1.0 / cells_per_a;
+  c.grid.origin = Vec2(0, -5 - 2 * h);
+  c.grid.h = h;
+  c.grid.nx = 5 * cells_per_a + 2;
+  c.grid.ny = 10 * cells_per_a + 4;
+  c.materials = {{"rock", 1e10, 0.25, 2500}};
+  Region r;
+  r.lo = Vec2(0, -5);
+  r.hi = Vec2(5, 5);
+  c.regions = {r};
+  c.constraints = {{Constraint::Kind::PlaneX, 0.0}};
+  CrackSpec crack;
+  for (int k = 0; k <= 2 * cells_per_a; ++k) crack.points.emplace_back(k / (2.0 * cells_per_a), 0.0);
+  c.cracks = {crack};
+  c.damping.grid_alpha = 688;
+  c.threads = threads;
+  return c;
+}
+
+// Bytes the solver holds per particle: particle arrays plus grid arrays / particles.
+double bytes_per_particle(const Solver& solid) {
+  const auto& p = solid.particles();
+  const double particle = sizeof(Vec2) * 3 + sizeof(double) * 3 + sizeof(Voigt) * 2 + sizeof(std::int32_t);
+  const double per_node = sizeof(double) + 2 * sizeof(Vec2) + 1 + 2 * sizeof(Vec2) + sizeof(std::uint32_t);
+  const double fields = solid.cracks().empty() ? 1 : 2;
+  const double threads = static_cast<double>(solid.config().threads);
+  const double grid = static_cast<double>(solid.grid().node_count()) * per_node * fields * (1 + threads);
+  return particle + grid / static_cast<double>(p.size());
+}
+
+template <class Make>
+void run(const char* name, Make make, int size, int steps) {
+  for (int threads : {1, 2}) {
+    Solver solid(make(size, threads));
+    if (!solid.cracks().empty()) solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), 1e6));
+    const double dt = solid.stable_dt();
+    solid.step(dt);  // warm up: first touch of the grid
+    const auto start = std::chrono::steady_clock::now();
+    for (int s = 0; s < steps; ++s) solid.step(dt);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double n = static_cast<double>(solid.particles().size());
+    std::printf("| %s | %.0f | %d | %d | %.3f | %.3g | %.0f |\n", name, n, threads, steps, wall, n * steps / wall,
+                bytes_per_particle(solid));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,16 +94,9 @@ int main(int argc, char** argv) {
     if (arg == "--cells") cells = std::stoi(argv[i + 1]);
     else if (arg == "--steps") steps = std::stoi(argv[i + 1]);
   }
-  std::printf("| case | particles | threads | steps | wall (s) | particle-steps/s |\n|---|---|---|---|---|---|\n");
-  for (int threads : {1, 2}) {
-    Solver solid(block(cells, threads));
-    const double dt = solid.stable_dt();
-    solid.step(dt);  // warm up: first touch of the grid
-    const auto start = std::chrono::steady_clock::now();
-    for (int s = 0; s < steps; ++s) solid.step(dt);
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const double n = static_cast<double>(solid.particles().size());
-    std::printf("| uncracked block | %.0f | %d | %d | %.3f | %.3g |\n", n, threads, steps, wall, n * steps / wall);
-  }
+  std::printf("| case | particles | threads | steps | wall (s) | particle-steps/s | bytes/particle |\n"
+              "|---|---|---|---|---|---|---|\n");
+  run("uncracked block", block, cells, steps);
+  run("Sneddon, cracked (h = a/20)", cracked, 20, steps);
   return 0;
 }
