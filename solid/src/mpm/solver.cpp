@@ -162,9 +162,11 @@ void Solver::step(double dt) {
   } else {
     for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h);
     p2g<true>();
+    contact(0.0);  // on the extrapolated momenta
     edge_loads();
     crack_loads();
     grid_update(dt);
+    contact(dt);  // on the updated momenta, forces made consistent
     g2p<true>(dt);
     move_crack_surfaces(dt);
   }
@@ -216,14 +218,17 @@ void Solver::p2g() {
             f0.momentum[n].setZero();
             f0.force[n].setZero();
             if constexpr (kCracks) {
+              f0.displaced[n].setZero();
               f1.mass[n] = 0;
               f1.momentum[n].setZero();
               f1.force[n].setZero();
+              f1.displaced[n].setZero();
             }
           }
           auto& f = (near && field_of(particles_.x[p], g.position(static_cast<int>(n)))) ? f1 : f0;
           f.mass[n] += w * m;
           f.momentum[n] += w * mv;
+          if constexpr (kCracks) f.displaced[n] += w * m * particles_.displacement[p];
           // internal force -V sigma . grad S (s = xx, yy, xy, zz)
           f.force[n] -= vol * Vec2(s[0] * gx + s[2] * gy, s[2] * gx + s[1] * gy);
         }
@@ -237,10 +242,12 @@ void Solver::p2g() {
       to.mass[u] = from.mass[u];
       to.momentum[u] = from.momentum[u];
       to.force[u] = from.force[u];
+      if constexpr (kCracks) to.displaced[u] = from.displaced[u];
     } else {
       to.mass[u] += from.mass[u];
       to.momentum[u] += from.momentum[u];
       to.force[u] += from.force[u];
+      if constexpr (kCracks) to.displaced[u] += from.displaced[u];
     }
   };
   for (std::size_t k = 0; k < thread_nodes_.size(); ++k) {
@@ -376,6 +383,7 @@ void Solver::g2p(double dt) {
     }
     particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
     particles_.x[p] += dt * v_new;
+    if constexpr (kCracks) particles_.displacement[p] += dt * v_new;
     // Small-strain elastic update, plane strain (eps_zz = 0).
     const double dxx = l00 * dt, dyy = l11 * dt, dxy = 0.5 * (l01 + l10) * dt;
     const auto m = static_cast<std::size_t>(particles_.material[p]);

@@ -2,6 +2,7 @@
 // particle-node pair uses, crack-face pressure into each side's field, and
 // the crack surfaces moved by their own side's field.
 #include <cmath>
+#include <limits>
 
 #include "hfmpm/solid/mpm/shape.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
@@ -137,6 +138,64 @@ void Solver::move_crack_surfaces(double dt) {
       }
     }
     crack.update_plane();
+  }
+}
+
+}  // namespace hfmpm::solid::mpm
+
+namespace hfmpm::solid::mpm {
+
+// Contact (Nairn 2003, section 2.3): where a node has both fields, the crack
+// surfaces there are in contact if the displacement-based opening along the
+// crack normal is negative AND they approach; then the normal components of
+// the two fields' velocities are made equal (frictionless), conserving momentum.
+void Solver::contact(double dt) {
+  const auto& g = config_.grid;
+  for (int n : active_) {
+    const auto u = static_cast<std::size_t>(n);
+    const double m0 = nodes_.mass[u], m1 = second_.mass[u];
+    if (m0 <= min_mass_ || m1 <= min_mass_) continue;
+    // Normal and orientation from the nearest crack particle.
+    const Vec2 x = g.position(n);
+    double best = std::numeric_limits<double>::infinity();
+    Vec2 normal = Vec2::UnitY();
+    Vec2 plane = x;
+    for (const auto& crack : cracks_) {
+      for (std::size_t k = 0; k < crack.size(); ++k) {
+        const double d = (crack.plane()[k] - x).squaredNorm();
+        if (d < best) {
+          best = d;
+          normal = crack.normal(k);
+          plane = crack.plane()[k];
+        }
+      }
+    }
+    // Field 0 holds the node's own side; above if the node is on the normal's side.
+    const bool field0_above = (x - plane).dot(normal) >= 0;
+    const Vec2 n_up = field0_above ? normal : Vec2(-normal);  // from field 1 towards field 0
+    const Vec2 p0 = dt > 0 ? Vec2(m0 * velocity_[0][u]) : nodes_.momentum[u];
+    const Vec2 p1 = dt > 0 ? Vec2(m1 * velocity_[1][u]) : second_.momentum[u];
+    // Opening = (u_field0 - u_field1) . n_up; approach = (v_field0 - v_field1) . n_up < 0.
+    const double opening = (nodes_.displaced[u] / m0 - second_.displaced[u] / m1).dot(n_up);
+    const double approach = (p0 / m0 - p1 / m1).dot(n_up);
+    if (!(opening < 0 && approach < 0)) continue;
+    const Vec2 dp = ((m0 * p1 - m1 * p0) / (m0 + m1)).dot(n_up) * n_up;  // to field 0
+    if (dt > 0) {
+      velocity_[0][u] += dp / m0;
+      velocity_[1][u] -= dp / m1;
+      acceleration_[0][u] += dp / (m0 * dt);
+      acceleration_[1][u] -= dp / (m1 * dt);
+      // A fixed component stays fixed.
+      for (int f = 0; f < 2; ++f) {
+        const std::uint8_t fixed = (f ? second_ : nodes_).fixed[u];
+        if (fixed & 1) velocity_[f][u].x() = acceleration_[f][u].x() = 0;
+        if (fixed & 2) velocity_[f][u].y() = acceleration_[f][u].y() = 0;
+      }
+    } else {
+      nodes_.momentum[u] += dp;
+      second_.momentum[u] -= dp;
+    }
+    ++contacts_;
   }
 }
 

@@ -21,6 +21,7 @@ struct Particles {
   std::vector<Voigt> stress;      // Pa, Cauchy stress including the initial stress
   std::vector<Voigt> strain;      // -, small strain since the start (eps_zz = 0)
   std::vector<Vec2> external;     // N/m, external force on the particle this step (tractions, dashpots)
+  std::vector<Vec2> displacement;  // m, since the start (kept only with cracks: contact needs it)
   std::vector<std::int32_t> material;  // index into the material table
 
   std::size_t size() const { return x.size(); }
@@ -33,6 +34,7 @@ struct Particles {
     stress.push_back(initial_stress);
     strain.push_back(Voigt::Zero());
     external.push_back(Vec2::Zero());
+    displacement.push_back(Vec2::Zero());
     material.push_back(mat);
   }
 };

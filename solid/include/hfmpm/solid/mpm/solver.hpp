@@ -32,6 +32,7 @@ class Solver {
 
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
+  std::uint64_t contacts() const { return contacts_; }  // node contacts applied so far
   double kinetic_energy() const;  // J/m, with the scaled masses
   const SolidConfig& config() const { return config_; }
   const Grid& grid() const { return config_.grid; }
@@ -68,6 +69,9 @@ class Solver {
   int field_of(const Vec2& from, const Vec2& node) const;  // 1 if the line crosses a crack
   void crack_loads();
   void move_crack_surfaces(double dt);
+  // Frictionless contact between the two fields of a node; dt = 0: on the
+  // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
+  void contact(double dt);
 
   SolidConfig config_;
   Particles particles_;
@@ -87,6 +91,7 @@ class Solver {
   std::uint32_t epoch_ = 0;
   double t_ = 0;
   std::uint64_t steps_ = 0;
+  std::uint64_t contacts_ = 0;
   double min_mass_ = 0;  // nodes lighter than this get zero velocity
 };
 
