@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "exchange_log.hpp"
+#include "heartbeat.hpp"
 #include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
 
@@ -39,53 +40,6 @@ std::string host_name() {
   char buffer[256] = {};
   return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
 }
-
-// Heartbeat interval before the scene's is known (between Hello and Welcome).
-// The scene validator keeps heartbeat_timeout_s >= 0.5 s, well above it.
-constexpr double kFirstHeartbeatIntervalS = 0.1;
-
-// Sends Heartbeat on its own socket at an interval until stopped.
-class HeartbeatThread {
- public:
-  HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role,
-                  const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting)
-      : thread_([this, &context, endpoint, role, &step, &waiting] {
-          zmq::socket_t socket(context, zmq::socket_type::dealer);
-          socket.set(zmq::sockopt::linger, 0);
-          socket.set(zmq::sockopt::routing_id, std::string(proto::role_name(role)) + ".hb");
-          socket.connect(endpoint);
-          std::uint64_t sequence = 0;
-          std::unique_lock lock(mutex_);
-          while (!stop_) {
-            protocol::Envelope envelope;
-            auto* beat = envelope.mutable_heartbeat();
-            beat->set_role(role);
-            beat->set_sequence(++sequence);
-            beat->set_step(step.load());
-            beat->set_waiting_for_peer(waiting.load());
-            (void)socket.send(zmq::buffer(proto::encode(envelope)), zmq::send_flags::dontwait);
-            wake_.wait_for(lock, to_us(interval_s_), [this] { return stop_; });
-          }
-        }) {}
-  ~HeartbeatThread() {
-    {
-      std::lock_guard lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-  }
-  HeartbeatThread(const HeartbeatThread&) = delete;
-  HeartbeatThread& operator=(const HeartbeatThread&) = delete;
-  void set_interval(double seconds) { interval_s_ = seconds; }
-
- private:
-  std::atomic<double> interval_s_{kFirstHeartbeatIntervalS};
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  bool stop_ = false;
-  std::thread thread_;
-};
 
 class SideRuntime {
  public:
@@ -494,31 +448,6 @@ class SideRuntime {
 };
 
 }  // namespace
-
-Fault Fault::parse(const std::string& text) {
-  const auto at = text.find('@');
-  const std::string kind = text.substr(0, at);
-  Fault fault;
-  if (kind == "exit") fault.kind = Kind::Exit;
-  else if (kind == "crash") fault.kind = Kind::Crash;
-  else if (kind == "hang") fault.kind = Kind::Hang;
-  else if (kind == "freeze") fault.kind = Kind::Freeze;
-  else if (kind == "garbage") fault.kind = Kind::Garbage;
-  else if (kind == "nan") fault.kind = Kind::NaN;
-  else {
-    throw InputError("--fault '" + text + "': unknown kind '" + kind +
-                     "'; allowed: exit, crash, hang, freeze, garbage, nan, as KIND@STEP");
-  }
-  try {
-    if (at == std::string::npos) throw std::invalid_argument("no step");
-    std::size_t used = 0;
-    fault.step = std::stoull(text.substr(at + 1), &used);
-    if (used != text.size() - at - 1 || fault.step == 0) throw std::invalid_argument("bad step");
-  } catch (const std::exception&) {
-    throw InputError("--fault '" + text + "': expected KIND@STEP with STEP a positive integer");
-  }
-  return fault;
-}
 
 int run_side(SideModel& model, const SideOptions& options) {
   // A side allocates and frees the same large buffers (frames of thousands of

@@ -1,0 +1,236 @@
+// The handshake (Hello, Welcome, Listening, Ready) and the step schedule:
+// dt, blocks of steps, reports, output rows, stuck sides.
+#include "coupler_session.hpp"
+
+namespace hfmpm::coupling::detail {
+
+void Coupler::handshake() {
+  using Pending = std::function<bool(const Side&)>;
+  // Waits until no expected side is `pending`; the error lists those that still are.
+  auto wait_until = [&](const Pending& pending, const std::string& what, const std::string& timeout_key,
+                        double timeout_s) {
+    const auto deadline = Clock::now() + microseconds(static_cast<std::int64_t>(timeout_s * 1e6));
+    while (true) {
+      std::string missing;
+      for (const auto& side : sides_) {
+        if (!side.expected || !pending(side)) continue;
+        if (!missing.empty()) missing += ", ";
+        missing += side.name;
+      }
+      if (missing.empty()) return;
+      if (Clock::now() > deadline) {
+        std::ostringstream out;
+        out << "no " << what << " within " << timeout_key << " = " << timeout_s << " s (still waiting for: " << missing
+            << ")";
+        throw RunFailure{out.str()};
+      }
+      auto message = pump(milliseconds(20));
+      if (message) on_handshake_message(*message->first, message->second);
+    }
+  };
+  const auto& coupling = scene_.coupling();
+  wait_until([](const Side& s) { return !s.joined; }, "Hello", "coupling.join_timeout_s", coupling.join_timeout_s());
+
+  // Setup (building each model) happens between Welcome and Ready; heartbeats
+  // prove the sides alive meanwhile, so this limit can be generous.
+  Side& solid = sides_[0];
+  Side& fluid = sides_[1];
+  protocol::Envelope welcome = welcome_for(fluid.expected ? protocol::DataPlane::BIND : protocol::DataPlane::NONE,
+                                           data_bind_);
+  send_to(solid, welcome);
+  if (fluid.expected) {
+    wait_until([](const Side& s) { return s.role == protocol::SOLID && s.data_endpoint.empty(); },
+               "Listening from the solid side", "coupling.setup_timeout_s", coupling.setup_timeout_s());
+    send_to(fluid, welcome_for(protocol::DataPlane::CONNECT, solid.data_endpoint));
+  }
+  wait_until([](const Side& s) { return !s.ready; }, "Ready", "coupling.setup_timeout_s", coupling.setup_timeout_s());
+  manifest_.set("status", "running");
+  manifest_.save();
+}
+
+protocol::Envelope Coupler::welcome_for(protocol::DataPlane::Mode mode, const std::string& endpoint) const {
+  protocol::Envelope envelope;
+  auto* welcome = envelope.mutable_welcome();
+  welcome->set_protocol_version(proto::kProtocolVersion);
+  welcome->set_run_id(run_id_);
+  *welcome->mutable_scene() = scene_;
+  welcome->set_output_dir(output_dir_);
+  welcome->mutable_data_plane()->set_mode(mode);
+  if (mode != protocol::DataPlane::NONE) welcome->mutable_data_plane()->set_endpoint(endpoint);
+  return envelope;
+}
+
+void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelope) {
+  if (!side.joined) {
+    if (!envelope.has_hello()) unexpected(side, envelope, "Hello");
+    const auto& hello = envelope.hello();
+    const std::string who = "the " + side.name + " side (" + hello.implementation() + " " +
+                            hello.implementation_version() + ")";
+    if (hello.role() != side.role) {
+      reject(side, who + " connected as '" + side.name + "' but says it is " +
+                       std::string(proto::role_name(hello.role())));
+    }
+    if (hello.protocol_version() != proto::kProtocolVersion) {
+      reject(side, who + " speaks protocol version " + std::to_string(hello.protocol_version()) +
+                       "; this coupler speaks version " + std::to_string(proto::kProtocolVersion));
+    }
+    side.joined = true;
+    side.implementation = hello.implementation() + " " + hello.implementation_version();
+    manifest_.set(side.name + "_implementation", side.implementation);
+    manifest_.set(side.name + "_host", hello.host());
+    log_(side.name + " side joined: " + side.implementation + " on " + hello.host() + ", pid " +
+         std::to_string(hello.pid()));
+    return;
+  }
+  if (envelope.has_listening() && side.role == protocol::SOLID && side.data_endpoint.empty()) {
+    side.data_endpoint = envelope.listening().data_endpoint();
+    manifest_.set("data_endpoint", side.data_endpoint);
+    return;
+  }
+  if (envelope.has_ready() && !side.ready) {
+    side.ready = true;
+    side.stable_dt = envelope.ready().stable_dt();
+    side.diagnostics = proto::from_proto(envelope.ready().diagnostics());
+    return;
+  }
+  unexpected(side, envelope, "Listening or Ready");
+}
+
+void Coupler::reject(Side& side, const std::string& reason) {
+  protocol::Envelope envelope;
+  envelope.mutable_reject()->set_reason(reason);
+  envelope.mutable_reject()->set_coupler_protocol_version(proto::kProtocolVersion);
+  try {
+    send_routed(router_, side.name, envelope);
+  } catch (const std::exception&) {
+  }
+  throw RunFailure{"rejected " + reason + " (handshake, step 0)"};
+}
+
+double Coupler::next_dt() {
+  double stable = kInf;
+  for (const auto& side : sides_) {
+    if (!side.expected) continue;
+    if (std::isnan(side.stable_dt) || side.stable_dt <= 0) {
+      throw RunFailure{"the " + side.name + " side reported a stable time step of " +
+                       std::to_string(side.stable_dt) + " s" + at_step() + "; it must be > 0"};
+    }
+    stable = std::min(stable, side.stable_dt);
+  }
+  if (!std::isfinite(stable)) throw RunFailure{"neither side reports a finite stable time step"};
+  return scene_.time().safety_factor() * stable;
+}
+
+void Coupler::step_loop(RunSummary& summary) {
+  History& history = *history_;
+  const auto start = Clock::now();
+  const double end = scene_.time().end_s();
+  const double interval = output_interval(scene_);
+  const std::uint32_t k = sides_[1].expected ? scene_.coupling().exchange_interval() : 1;
+  const std::uint64_t block = (std::uint64_t{scene_.coupling().control_interval()} + k - 1) / k * k;
+  double dt = next_dt();
+  history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+  std::uint64_t frame = 1;
+  double next_output = interval;
+  double mean_command_s = 0;
+  const std::uint64_t max_steps = scene_.time().max_steps();
+  while (t_ < end * (1 - 1e-12)) {
+    // Steps to reach the next output time (and the end), rounded up to whole exchange windows.
+    auto steps_to = [&](double target) {
+      const double n = std::ceil((target - t_) / dt * (1 - 1e-12));
+      const auto steps = static_cast<std::uint64_t>(std::max(1.0, n));
+      return (steps + k - 1) / k * k;
+    };
+    // time.max_steps, in whole exchange windows (a command never splits one).
+    const std::uint64_t to_max = (max_steps - step_) / k * k;
+    if (to_max == 0) break;
+    const std::uint64_t n = std::min({block, steps_to(std::min(next_output, end)), to_max});
+    const double t_end = t_ + static_cast<double>(n) * dt;
+    const bool last_allowed = n == to_max && max_steps - step_ - n < k;
+    const bool output = t_end >= next_output * (1 - 1e-12) || t_end >= end * (1 - 1e-12) || last_allowed;
+
+    protocol::Envelope envelope;
+    auto* command = envelope.mutable_step_command();
+    command->set_first_step(step_);
+    command->set_num_steps(static_cast<std::uint32_t>(n));
+    command->set_t(t_);
+    command->set_dt(dt);
+    command->set_write_output(output);
+    command->set_output_frame(output ? frame : 0);
+    const auto command_start = Clock::now();
+    for (auto& side : sides_) {
+      if (!side.expected) continue;
+      side.report.reset();
+      send_to(side, envelope);
+    }
+    // The sides accumulate t the same way, so the times agree bit for bit.
+    double t_expected = t_;
+    for (std::uint64_t i = 0; i < n; ++i) t_expected += dt;
+    await_reports(step_ + n, t_expected, std::max(scene_.coupling().step_timeout_s(), 20 * mean_command_s));
+    const double command_s = seconds_since(command_start);
+    mean_command_s = summary.commands == 0 ? command_s : 0.9 * mean_command_s + 0.1 * command_s;
+    ++summary.commands;
+    step_ += n;
+    t_ = t_expected;
+    for (auto& side : sides_) {
+      if (!side.expected) continue;
+      side.stable_dt = side.report->stable_dt();
+      side.diagnostics = proto::from_proto(side.report->diagnostics());
+      side.compute_s += side.report->compute_s();
+      side.exchange_s += side.report->exchange_s();
+    }
+    if (output) {  // dt_s: the step that led to this row
+      history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+      ++frame;
+      while (next_output <= t_ * (1 + 1e-12)) next_output += interval;
+    }
+    if (t_ < end * (1 - 1e-12)) dt = next_dt();
+    progress_.update(t_, step_, seconds_since(start));
+  }
+  summary.stepping_wall_s = seconds_since(start);
+  if (t_ < end * (1 - 1e-12)) {
+    stopped_at_max_steps_ = true;
+    log_("stopped at step " + std::to_string(step_) + " (time.max_steps = " + std::to_string(max_steps) +
+         ", in whole exchange windows) before time.end_s");
+  }
+}
+
+void Coupler::await_reports(std::uint64_t step, double t, double timeout_s) {
+  const auto deadline = Clock::now() + microseconds(static_cast<std::int64_t>(timeout_s * 1e6));
+  auto pending = [&] {
+    for (auto& side : sides_) {
+      if (side.expected && !side.report) return true;
+    }
+    return false;
+  };
+  while (pending()) {
+    if (Clock::now() > deadline) throw RunFailure{hung_message(timeout_s)};
+    auto message = pump(milliseconds(20));
+    if (!message) continue;
+    auto& [side, envelope] = *message;
+    if (!envelope.has_step_report() || side->report) unexpected(*side, envelope, "StepReport");
+    const auto& report = envelope.step_report();
+    if (report.step() != step || report.t() != t) {
+      std::ostringstream out;
+      out << std::setprecision(17) << "the " << side->name << " side reports step " << report.step() << " at t = " << report.t()
+          << " s, but step " << step << " at t = " << t << " s was commanded";
+      throw RunFailure{out.str()};
+    }
+    side->report = report;
+  }
+}
+
+std::string Coupler::hung_message(double timeout_s) const {
+  std::string blamed;
+  for (const auto& side : sides_) {
+    if (side.expected && !side.report && !side.waiting_for_peer) blamed += (blamed.empty() ? "" : " and ") + side.name;
+  }
+  if (blamed.empty()) blamed = "solid and fluid";
+  std::ostringstream out;
+  out << "the " << blamed << " side" << (blamed.find(" and ") != std::string::npos ? "s" : "")
+      << " stopped making progress" << at_step() << ": no StepReport within " << timeout_s
+      << " s (coupling.step_timeout_s) although heartbeats still arrive";
+  return out.str();
+}
+
+}  // namespace hfmpm::coupling::detail

@@ -1,0 +1,144 @@
+// Private to the coupler: the state of one run and the steps it goes
+// through. coupler.cpp: start, launch and shutdown; coupler_liveness.cpp:
+// messages in, heartbeats, dead and stuck sides; coupler_schedule.cpp: the
+// handshake and the step schedule.
+#pragma once
+
+#include "hfmpm/coupling/coupler.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <random>
+#include <sstream>
+#include <thread>
+
+#include "hfmpm/coupling/process.hpp"
+#include "hfmpm/coupling/scene_loader.hpp"
+#include "hfmpm/coupling/transport.hpp"
+#include "hfmpm/proto/convert.hpp"
+#include "run_output.hpp"
+
+namespace hfmpm::coupling::detail {
+
+namespace fs = std::filesystem;
+using std::chrono::microseconds;
+using std::chrono::milliseconds;
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A run cannot go on; the text names the side, the step and what happened.
+struct RunFailure {
+  std::string message;
+};
+
+struct Side {
+  protocol::Role role = protocol::ROLE_UNSPECIFIED;
+  std::string name;  // routing id: "solid" or "fluid"
+  bool expected = false;
+  bool joined = false;
+  bool ready = false;
+  bool stopping = false;
+  std::string implementation;
+  std::string log_path;
+  std::unique_ptr<ChildProcess> process;
+  std::thread thread;
+  std::shared_ptr<std::atomic<int>> thread_exit;  // in-process side: -1 while running
+  Clock::time_point last_heard = Clock::now();
+  Clock::time_point last_sent = Clock::now();
+  std::uint64_t heartbeat_step = 0;
+  bool waiting_for_peer = false;
+  double stable_dt = kInf;
+  SideDiagnostics diagnostics;
+  std::optional<protocol::StepReport> report;
+  std::string data_endpoint;
+  double compute_s = 0, exchange_s = 0;
+};
+
+inline std::string random_id() {
+  std::random_device device;
+  std::ostringstream out;
+  out << std::hex << device() << device();
+  return out.str().substr(0, 12);
+}
+
+inline std::string host_name() {
+  char buffer[256] = {};
+  return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
+}
+
+inline bool loopback(const std::string& host) {
+  return host == "localhost" || host.rfind("127.", 0) == 0 || host == "::1";
+}
+
+class Coupler {
+ public:
+  Coupler(const scene::Scene& scene, const RunOptions& options);
+  ~Coupler();
+  RunSummary run();
+
+ private:
+  // ---------------------------------------------------------------- start
+  void prepare();
+  std::string program_for(const Side& side) const;
+  void launch_sides();
+
+  // --------------------------------------------------------- messages in
+  Side* side_named(const std::string& name);
+  std::string at_step() const { return " at step " + std::to_string(step_); }
+
+  std::string log_hint(const Side& side) const;
+
+  // One message from a side, or nullopt after `wait`; runs the liveness checks.
+  std::optional<std::pair<Side*, protocol::Envelope>> pump(microseconds wait);
+  void housekeeping();
+  std::string ended_message(Side& side, const std::string& ended);
+
+  // After a side ended: its last words, if it sent an Error before going.
+  std::string drain_error_from(Side& side);
+  void send_to(Side& side, const protocol::Envelope& envelope);
+  [[noreturn]] void unexpected(const Side& side, const protocol::Envelope& envelope, const std::string& expected);
+
+  // ------------------------------------------------------------ handshake
+  void handshake();
+  protocol::Envelope welcome_for(protocol::DataPlane::Mode mode, const std::string& endpoint) const;
+  void on_handshake_message(Side& side, const protocol::Envelope& envelope);
+  [[noreturn]] void reject(Side& side, const std::string& reason);
+
+  // ------------------------------------------------------------- stepping
+  double next_dt();
+  void step_loop(RunSummary& summary);
+  void await_reports(std::uint64_t step, double t, double timeout_s);
+  std::string hung_message(double timeout_s) const;
+
+  // ------------------------------------------------------------- shutdown
+  void stop_sides(bool error, const std::string& reason);
+
+  scene::Scene scene_;
+  RunOptions options_;
+  std::unique_ptr<zmq::context_t> context_ = std::make_unique<zmq::context_t>(1);
+  zmq::socket_t router_;
+  Side sides_[2];
+  std::string run_id_, output_dir_, control_endpoint_, data_bind_, ipc_dir_;
+  Manifest manifest_{""};
+  std::unique_ptr<History> history_;
+  bool prepared_ = false;
+  bool leak_context_ = false;
+  bool stopped_at_max_steps_ = false;
+  Log log_;
+  Progress progress_;
+  microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};
+  Clock::time_point start_ = Clock::now(), last_housekeeping_{};
+  std::uint64_t step_ = 0;
+  std::uint64_t heartbeats_sent_ = 0;
+  double t_ = 0;
+};
+
+}  // namespace hfmpm::coupling::detail
