@@ -58,11 +58,13 @@ SolidConfig cracked(int cells_per_a, int threads) {
   return c;
 }
 
-// Bytes the solver holds per particle: particle arrays plus grid arrays / particles.
+// Bytes the solver holds per particle: particle arrays (x, v, displacement,
+// mass, volume, half size, stress, material) plus grid arrays / particles.
 double bytes_per_particle(const Solver& solid) {
   const auto& p = solid.particles();
-  const double particle = sizeof(Vec2) * 3 + sizeof(double) * 3 + sizeof(Voigt) * 2 + sizeof(std::int32_t);
-  const double per_node = sizeof(double) + 2 * sizeof(Vec2) + 1 + 2 * sizeof(Vec2) + sizeof(std::uint32_t);
+  const double particle = sizeof(Vec2) * 3 + sizeof(double) * 3 + sizeof(Voigt) + sizeof(std::int32_t);
+  // mass, momentum, force, displaced, fixed; velocity and acceleration; stamp
+  const double per_node = sizeof(double) + 3 * sizeof(Vec2) + 1 + 2 * sizeof(Vec2) + sizeof(std::uint32_t);
   const double fields = solid.cracks().empty() ? 1 : 2;
   const double threads = static_cast<double>(solid.config().threads);
   const double grid = static_cast<double>(solid.grid().node_count()) * per_node * fields * (1 + threads);

@@ -389,7 +389,6 @@ void Solver::g2p(double dt) {
     const auto m = static_cast<std::size_t>(particles_.material[p]);
     const double lam = lambda_[m], mu = shear_[m];
     const double tr = dxx + dyy;
-    particles_.strain[p] += Voigt(dxx, dyy, dxy, 0);
     particles_.stress[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
     const Vec2& x = particles_.x[p];
     if (!(x.x() >= lo.x() && x.y() >= lo.y() && x.x() <= hi.x() && x.y() <= hi.y())) {

@@ -64,7 +64,7 @@ void for_side_nodes(const Solver& solver, const Grid& g, const NodalFields* fiel
     for (int b = 0; b < 2; ++b) {
       if (!g.inside(cell.i + a, cell.j + b)) continue;
       const int nd = g.node(cell.i + a, cell.j + b);
-      const int f = solver.field_of_public(test, g.position(nd));
+      const int f = solver.field_of(test, g.position(nd));
       const double w = cell.w[a][b];
       if (w <= 0 || fields[f]->mass[static_cast<std::size_t>(nd)] <= min_mass) continue;
       node[count] = nd;

@@ -9,7 +9,7 @@
 
 namespace hfmpm::solid::mpm {
 
-// Stress or strain in plane strain as (xx, yy, xy, zz); tension positive.
+// Stress in plane strain as (xx, yy, xy, zz); tension positive.
 using Voigt = Eigen::Vector4d;
 
 struct Particles {
@@ -19,8 +19,6 @@ struct Particles {
   std::vector<double> volume;     // m^2, initial area (small strain: kept constant)
   std::vector<double> half_size;  // m, uGIMP half-width lp
   std::vector<Voigt> stress;      // Pa, Cauchy stress including the initial stress
-  std::vector<Voigt> strain;      // -, small strain since the start (eps_zz = 0)
-  std::vector<Vec2> external;     // N/m, external force on the particle this step (tractions, dashpots)
   std::vector<Vec2> displacement;  // m, since the start (kept only with cracks: contact needs it)
   std::vector<std::int32_t> material;  // index into the material table
 
@@ -32,8 +30,6 @@ struct Particles {
     volume.push_back(v0);
     half_size.push_back(lp);
     stress.push_back(initial_stress);
-    strain.push_back(Voigt::Zero());
-    external.push_back(Vec2::Zero());
     displacement.push_back(Vec2::Zero());
     material.push_back(mat);
   }

@@ -49,8 +49,9 @@ class Solver {
   // The nodal fields of one side of a crack: field 1 holds the particles whose
   // line to the node crosses a crack (only near cracks).
   const NodalFields& nodes(int field) const { return field ? second_ : nodes_; }
-  // 1 if the segment from `from` to `node` crosses a crack an odd number of times.
-  int field_of_public(const Vec2& from, const Vec2& node) const { return field_of(from, node); }
+  // Which field of `node` a point at `from` uses: 1 if the segment between
+  // them crosses a crack an odd number of times, else 0.
+  int field_of(const Vec2& from, const Vec2& node) const;
   // Crack-face pressure, Pa, per crack particle of crack c (resized to the crack).
   void set_crack_pressure(std::size_t c, const std::vector<double>& pressure);
 
@@ -66,7 +67,6 @@ class Solver {
   void g2p(double dt);
   // Cracks (solver_cracks.cpp)
   bool near_crack(const Vec2& x) const;
-  int field_of(const Vec2& from, const Vec2& node) const;  // 1 if the line crosses a crack
   void crack_loads();
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
