@@ -1,6 +1,7 @@
 #include "hfmpm/solid/mpm/crack.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "hfmpm/solid/mpm/predicates.hpp"
@@ -29,6 +30,14 @@ void Crack::append(const Vec2& position) {
   pressure_.push_back(0.0);
 }
 
+void Crack::prepend(const Vec2& position) {
+  ids_.insert(ids_.begin(), next_id_++);
+  plane_.insert(plane_.begin(), position);
+  above_.insert(above_.begin(), position);
+  below_.insert(below_.begin(), position);
+  pressure_.insert(pressure_.begin(), 0.0);
+}
+
 Vec2 Crack::normal(std::size_t k) const {
   Vec2 n = Vec2::Zero();
   if (k > 0) n += left_normal(plane_[k - 1], plane_[k]);
@@ -45,7 +54,8 @@ double Crack::tributary_length(std::size_t k) const {
 
 double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(normal(k))); }
 
-void Crack::prepare(double extension) {
+void Crack::prepare(double extension, double tip_tolerance) {
+  tip_tolerance_ = tip_tolerance;
   path_.clear();
   const std::size_t n = plane_.size();
   if (!start_is_tip_) path_.push_back(plane_[0] - extension * (plane_[1] - plane_[0]).normalized());
@@ -74,7 +84,20 @@ bool Crack::crosses(const Vec2& p, const Vec2& q) const {
         std::min(a.y(), b.y()) > hi.y()) {
       continue;
     }
-    if (segments_cross(p, q, a, b)) odd = !odd;
+    // A particle-node line through a tip point itself passes the crack's end:
+    // not a crossing (the material is whole at the tip, and a node at the tip
+    // keeps one field). "Through" means within tip_tolerance_ (a millionth of
+    // a cell) of the tip, so that a tip sitting on a node, as it does when a
+    // crack runs along a grid line, does not connect and cut that node from
+    // one step to the next as round-off moves the tip by 1e-16 m.
+    auto through = [&](const Vec2& tip) {
+      const Vec2 d = q - p;
+      const double t = std::clamp((tip - p).dot(d) / d.squaredNorm(), 0.0, 1.0);
+      return (p + t * d - tip).squaredNorm() <= tip_tolerance_ * tip_tolerance_;
+    };
+    const bool tip_a = s == 0 && start_is_tip_, tip_b = s + 2 == path_.size() && end_is_tip_;
+    if ((tip_a && through(a)) || (tip_b && through(b)) || !segments_cross(p, q, a, b)) continue;
+    odd = !odd;
   }
   return odd;
 }

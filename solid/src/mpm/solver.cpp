@@ -61,10 +61,17 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
   }
   if (cracked) second_.resize(n);
   generate_particles();
+  if (cracked) {
+    particles_.displacement.assign(particles_.size(), Vec2::Zero());
+    particles_.grad_u.assign(particles_.size(), Eigen::Matrix2d::Zero());
+  }
   build_constraints();
   find_edges();
   double lightest = std::numeric_limits<double>::infinity();
-  for (double m : particles_.mass) lightest = std::min(lightest, m);
+  for (double m : particles_.mass) {
+    lightest = std::min(lightest, m);
+    total_mass_ += m;
+  }
   min_mass_ = 1e-9 * lightest;
 }
 
@@ -128,6 +135,8 @@ void Solver::find_edges() {
     lo = lo.cwiseMin(particles_.x[p] - half);
     hi = hi.cwiseMax(particles_.x[p] + half);
   }
+  body_lo_ = lo;
+  body_hi_ = hi;
   const double tol = 1e-6 * config_.grid.h;
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     const Vec2 a = particles_.x[p] - Vec2::Constant(particles_.half_size[p]);
@@ -160,7 +169,7 @@ void Solver::step(double dt) {
     grid_update(dt);
     g2p<false>(dt);
   } else {
-    for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h);
+    for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h, 1e-6 * config_.grid.h);
     p2g<true>();
     contact(0.0);  // on the extrapolated momenta
     edge_loads();
@@ -172,6 +181,11 @@ void Solver::step(double dt) {
   }
   t_ += dt;
   ++steps_;
+  if (config_.damping.feedback_q > 0) update_feedback(dt);
+  if (config_.fracture.propagate && !cracks_.empty() &&
+      steps_ % static_cast<std::uint64_t>(std::max(1, config_.fracture.check_interval)) == 0) {
+    propagate();
+  }
 }
 
 template <bool kCracks>
@@ -318,7 +332,7 @@ void Solver::edge_loads() {
 }
 
 void Solver::grid_update(double dt) {
-  const double alpha = config_.damping.grid_alpha;
+  const double alpha = config_.damping.grid_alpha + feedback_alpha_;
   const int fields = cracks_.empty() ? 1 : 2;
   for (int field = 0; field < fields; ++field) {
     const NodalFields& nodes = field ? second_ : nodes_;
@@ -383,7 +397,14 @@ void Solver::g2p(double dt) {
     }
     particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
     particles_.x[p] += dt * v_new;
-    if constexpr (kCracks) particles_.displacement[p] += dt * v_new;
+    if constexpr (kCracks) {
+      particles_.displacement[p] += dt * v_new;
+      auto& gu = particles_.grad_u[p];
+      gu(0, 0) += dt * l00;
+      gu(0, 1) += dt * l01;
+      gu(1, 0) += dt * l10;
+      gu(1, 1) += dt * l11;
+    }
     // Small-strain elastic update, plane strain (eps_zz = 0).
     const double dxx = l00 * dt, dyy = l11 * dt, dxy = 0.5 * (l01 + l10) * dt;
     const auto m = static_cast<std::size_t>(particles_.material[p]);

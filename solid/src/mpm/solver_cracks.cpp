@@ -1,9 +1,11 @@
 // The crack parts of the MPM step (CRAMP): which velocity field a
 // particle-node pair uses, crack-face pressure into each side's field, and
 // the crack surfaces moved by their own side's field.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "hfmpm/solid/mpm/predicates.hpp"
 #include "hfmpm/solid/mpm/shape.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
 
@@ -56,7 +58,9 @@ void for_side_nodes(const Solver& solver, const Grid& g, const NodalFields* fiel
                     std::size_t k, int side, double min_mass, Visit&& visit) {
   const Vec2 n = crack.normal(k);
   const Vec2 test = crack.plane()[k] + side * 1e-6 * g.h * n;  // a point just off the plane on that side
-  const auto cell = cell_weights(g, crack.surface(side)[k]);
+  // The cell of the surface point nudged to its own side: a closed surface on
+  // a grid line would otherwise take the cell above for both sides.
+  const auto cell = cell_weights(g, crack.surface(side)[k] + side * 1e-6 * g.h * n);
   int node[4], field[4];
   double weight[4], total = 0;
   int count = 0;
@@ -155,23 +159,38 @@ void Solver::contact(double dt) {
     const auto u = static_cast<std::size_t>(n);
     const double m0 = nodes_.mass[u], m1 = second_.mass[u];
     if (m0 <= min_mass_ || m1 <= min_mass_) continue;
-    // Normal and orientation from the nearest crack particle.
+    // Normal from the nearest crack particle; the side of the node from the
+    // nearer of its two segments, with the same exact predicate and the same
+    // convention (on the line counts as left, i.e. above) as the side tests
+    // that filled the fields. (A tolerance-free distance test would flip with
+    // round-off when the node lies on the crack.)
     const Vec2 x = g.position(n);
     double best = std::numeric_limits<double>::infinity();
-    Vec2 normal = Vec2::UnitY();
-    Vec2 plane = x;
+    const Crack* nearest = nullptr;
+    std::size_t nearest_k = 0;
     for (const auto& crack : cracks_) {
       for (std::size_t k = 0; k < crack.size(); ++k) {
         const double d = (crack.plane()[k] - x).squaredNorm();
         if (d < best) {
           best = d;
-          normal = crack.normal(k);
-          plane = crack.plane()[k];
+          nearest = &crack;
+          nearest_k = k;
         }
       }
     }
-    // Field 0 holds the node's own side; above if the node is on the normal's side.
-    const bool field0_above = (x - plane).dot(normal) >= 0;
+    const auto& pl = nearest->plane();
+    auto distance_to = [&](std::size_t a) {
+      const Vec2 ab = pl[a + 1] - pl[a];
+      const double t = std::clamp((x - pl[a]).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+      return (pl[a] + t * ab - x).squaredNorm();
+    };
+    std::size_t seg = nearest_k + 1 < pl.size() ? nearest_k : nearest_k - 1;
+    if (nearest_k > 0 && nearest_k + 1 < pl.size() && distance_to(nearest_k - 1) < distance_to(nearest_k)) {
+      seg = nearest_k - 1;
+    }
+    const Vec2 normal = nearest->normal(nearest_k);
+    // Field 0 holds the node's own side; above if the node is left of the crack.
+    const bool field0_above = orient2d(pl[seg], pl[seg + 1], x) >= 0;
     const Vec2 n_up = field0_above ? normal : Vec2(-normal);  // from field 1 towards field 0
     const Vec2 p0 = dt > 0 ? Vec2(m0 * velocity_[0][u]) : nodes_.momentum[u];
     const Vec2 p1 = dt > 0 ? Vec2(m1 * velocity_[1][u]) : second_.momentum[u];

@@ -52,6 +52,25 @@ struct Traction {
 struct Damping {
   double grid_alpha = 0;  // 1/s: grid force -= alpha * momentum
   double pic_fraction = 0;  // 0 = pure FLIP, 1 = pure PIC velocity update
+  // Feedback (Nose-Hoover) damping for quasi-static loading: a second grid
+  // damping coefficient alpha_f >= 0 that follows
+  //   d alpha_f / dt = (2 KE / M - 2 KE_target / M) / feedback_q,
+  // so it rises while the body moves and relaxes when it is still. 0: off.
+  // feedback_q (m^2) sets how fast: alpha_f climbs by v^2 / q per second at
+  // a mean speed v; q ~ v^2 / omega^2 for the lowest frequency omega you want to damp.
+  double feedback_q = 0;
+  double feedback_target_ke = 0;  // J/m
+};
+
+// J-integral, stress intensity and growth of the cracks' tips.
+struct Fracture {
+  // The J domain around a tip is a square in the tip's frame: weight q = 1
+  // within inner_cells cells of the tip, falling linearly to 0 at outer_cells.
+  double inner_cells = 2.0;
+  double outer_cells = 5.0;
+  bool propagate = false;      // grow tips where J >= J_Ic of the material there
+  double growth_cells = 0.5;   // a new crack particle this many cells ahead of the tip
+  int check_interval = 1;      // steps between checks while propagating
 };
 
 struct SolidConfig {
@@ -66,6 +85,7 @@ struct SolidConfig {
   std::vector<Edge> silent_edges;  // absorbing (dashpot) edges
   Damping damping;
   std::vector<CrackSpec> cracks;
+  Fracture fracture;
   int threads = 1;
 };
 

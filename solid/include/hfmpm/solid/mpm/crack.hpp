@@ -41,8 +41,9 @@ class Crack {
   double width(std::size_t k) const;
 
   // Before each step: segment bounding boxes; `extension` is how far a mouth
-  // (non-tip) end is extended beyond the body for the side tests.
-  void prepare(double extension);
+  // (non-tip) end is extended beyond the body for the side tests; a
+  // particle-node line passing within `tip_tolerance` of a tip does not cross.
+  void prepare(double extension, double tip_tolerance);
   // Parity of crossings of the segment p-q with the crack (extended at mouths).
   bool crosses(const Vec2& p, const Vec2& q) const;
   // Axis-aligned box around the crack (with extensions), grown by `margin`.
@@ -53,6 +54,9 @@ class Crack {
 
   // Appends a crack particle at the end (growth); it starts closed.
   void append(const Vec2& position);
+  // Inserts a crack particle before the first (growth of a start tip; only
+  // for cracks inside the body, which no fluid uses); it starts closed.
+  void prepend(const Vec2& position);
 
  private:
   std::uint32_t id_;
@@ -64,6 +68,7 @@ class Crack {
   // Side-test geometry: the plane polyline with extended mouth ends.
   std::vector<Vec2> path_;
   Vec2 lo_ = Vec2::Zero(), hi_ = Vec2::Zero();
+  double tip_tolerance_ = 0;
 };
 
 }  // namespace hfmpm::solid::mpm

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace hfmpm::solid::mpm {
@@ -12,6 +13,9 @@ struct Material {
   double youngs_modulus = 0;  // Pa
   double poisson_ratio = 0;   // -
   double density = 0;         // kg/m^3 (before any density scaling)
+  // Critical energy release rate J_Ic (J/m^2) for crack growth in this
+  // material; infinite: cracks do not grow here. From K_Ic: J_Ic = K_Ic^2 / E'.
+  double toughness = std::numeric_limits<double>::infinity();
 
   double shear_modulus() const { return youngs_modulus / (2 * (1 + poisson_ratio)); }
   double lame_lambda() const {

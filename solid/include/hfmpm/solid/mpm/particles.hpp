@@ -19,7 +19,10 @@ struct Particles {
   std::vector<double> volume;     // m^2, initial area (small strain: kept constant)
   std::vector<double> half_size;  // m, uGIMP half-width lp
   std::vector<Voigt> stress;      // Pa, Cauchy stress including the initial stress
-  std::vector<Vec2> displacement;  // m, since the start (kept only with cracks: contact needs it)
+  // Kept only with cracks (empty otherwise): contact needs the displacement,
+  // the J-integral its gradient.
+  std::vector<Vec2> displacement;  // m, since the start
+  std::vector<Eigen::Matrix2d> grad_u;  // du_i/dx_j since the start (small strain)
   std::vector<std::int32_t> material;  // index into the material table
 
   std::size_t size() const { return x.size(); }
@@ -30,7 +33,6 @@ struct Particles {
     volume.push_back(v0);
     half_size.push_back(lp);
     stress.push_back(initial_stress);
-    displacement.push_back(Vec2::Zero());
     material.push_back(mat);
   }
 };

@@ -22,6 +22,20 @@
 
 namespace hfmpm::solid::mpm {
 
+// The state of one crack tip (fracture.cpp).
+struct TipResult {
+  std::size_t crack = 0;
+  bool at_end = true;              // the crack's last particle (false: its first)
+  Vec2 position = Vec2::Zero();    // m
+  Vec2 direction = Vec2::UnitX();  // unit, along the last segment, out of the crack
+  double j = 0;          // J/m^2: energy release rate (area integral plus face-load work)
+  double j_faces = 0;    // J/m^2: the face-load part of j
+  double k1 = 0, k2 = 0; // Pa m^0.5, from j split by the crack opening near the tip
+  double kink = 0;       // rad, growth direction by maximum hoop stress, counter-clockwise from direction
+  double toughness = 0;  // J/m^2, J_Ic of the material at the tip
+  double modulus = 0;    // Pa, plane-strain E' there
+};
+
 class Solver {
  public:
   explicit Solver(SolidConfig config);
@@ -55,6 +69,20 @@ class Solver {
   // Crack-face pressure, Pa, per crack particle of crack c (resized to the crack).
   void set_crack_pressure(std::size_t c, const std::vector<double>& pressure);
 
+  // J, K_I, K_II and the kink angle at every tip, evaluated now (one pass
+  // over the particles near the tips). Quasi-static J: no kinetic terms.
+  std::vector<TipResult> tips() const;
+  // The tips as last evaluated by the propagation check (empty without one).
+  const std::vector<TipResult>& last_tips() const { return last_tips_; }
+  // Grows every tip whose J >= J_Ic by one crack particle in the maximum hoop
+  // stress direction; returns the number of particles added. step() calls it
+  // every check_interval steps when propagation is on.
+  int propagate();
+  // Feedback damping coefficient now, 1/s.
+  double feedback_alpha() const { return feedback_alpha_; }
+  // The region (later wins) and so material and in-situ stress at x; -1 if none.
+  int region_at(const Vec2& x) const;
+
  private:
   void generate_particles();
   void build_constraints();
@@ -73,7 +101,14 @@ class Solver {
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
   void contact(double dt);
 
+  TipResult evaluate_tip(std::size_t c, bool at_end) const;
+  void update_feedback(double dt);
+
   SolidConfig config_;
+  std::vector<TipResult> last_tips_;
+  double feedback_alpha_ = 0;
+  double total_mass_ = 0;
+  Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
   Particles particles_;
   NodalFields nodes_;                 // reduced fields, field 0
   NodalFields second_;                // field 1 (other side of a crack); sized only with cracks
