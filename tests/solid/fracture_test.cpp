@@ -10,57 +10,10 @@
 #include <map>
 #include <numbers>
 
-#include "hfmpm/solid/mpm/solver.hpp"
+#include "fracture_setup.hpp"
 
 namespace hfmpm::solid::mpm {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
-const Material kRock{"rock", 1e10, 0.25, 2500};
-
-// Single edge crack in a strip under remote tension (Tada, Paris and Irwin,
-// The Stress Analysis of Cracks Handbook, 3rd ed., 2.10; ~0.5% for all a/W):
-//   F = sqrt(2 / (pi al) tan(pi al / 2)) (0.752 + 2.02 al + 0.37 (1 - sin(pi al / 2))^3) / cos(pi al / 2)
-// K_I = F sigma sqrt(pi a). F(0.3) = 1.6551.
-double tada_edge_factor(double al) {
-  const double b = kPi * al / 2;
-  return std::sqrt(std::tan(b) / b) * (0.752 + 2.02 * al + 0.37 * std::pow(1 - std::sin(b), 3)) / std::cos(b);
-}
-
-// Near-critical grid damping for the lowest mode of a body of size `length`.
-double critical_alpha(double length) { return 2 * kPi * kRock.p_wave_speed(kRock.density) / (4 * length); }
-
-// Steps until `transits` P-wave transits of `length` have passed.
-void settle(Solver& solid, double length, double transits) {
-  const double dt = solid.stable_dt();
-  const double end = solid.time() + transits * length / kRock.p_wave_speed(kRock.density);
-  while (solid.time() < end) solid.step(dt);
-}
-
-// Strip [0, W] x [-H, H] with an edge crack from (0, 0) to (a, 0) along a grid
-// line, pulled by sigma(t) on the top and bottom edges.
-SolidConfig edge_crack(double w, double a, double half_height, int cells_across, TimeFunction sigma) {
-  const double h = w / cells_across;
-  SolidConfig c;
-  c.grid.origin = Vec2(-2 * h, -half_height - 2 * h);
-  c.grid.h = h;
-  c.grid.nx = cells_across + 4;
-  c.grid.ny = static_cast<int>(std::lround(2 * half_height / h)) + 4;
-  c.materials = {kRock};
-  Region r;
-  r.lo = Vec2(0, -half_height);
-  r.hi = Vec2(w, half_height);
-  c.regions = {r};
-  c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
-  CrackSpec crack;
-  const int segments = static_cast<int>(std::lround(2 * a / h));  // every half cell
-  for (int k = 0; k <= segments; ++k) crack.points.emplace_back(a * k / segments, 0.0);
-  crack.start_is_tip = false;  // the mouth, on the left edge
-  c.cracks = {crack};
-  c.damping.grid_alpha = critical_alpha(2 * half_height);
-  c.threads = 2;
-  return c;
-}
 
 // K_I from J of an edge crack, a/W = 0.3, half-height 1.5 W (Tada's strip is
 // long: at half-height >= W the factor is within 1% of the infinite strip).

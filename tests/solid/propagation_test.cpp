@@ -1,0 +1,132 @@
+// Crack growth: the onset load of an edge crack under slowly rising tension
+// against the handbook (J_Ic reached), growth straight ahead in mode I, and
+// a pressurised crack in the stiffer of two bonded layers turning towards the
+// softer one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "fracture_setup.hpp"
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+// Edge crack a/W = 0.3 in a strip (half-height 1.5 W, h = W/40) pulled by
+// sigma(t) rising linearly; growth when J >= J_Ic. The handbook onset load is
+//   sigma_c = sqrt(E' J_Ic) / (F sqrt(pi a)),   F = 1.6551 (Tada).
+// The ramp reaches sigma_c after 30 P-wave transits of the strip (quasi-static:
+// the damped response lags the load by about 2%). Measured: growth starts at
+// sigma = 1.041 sigma_c, where the computed J is 1.012 J_Ic; the handbook J
+// there is 1.084 J_Ic: 1.7% of the load is the discretization (K from J is
+// 1.7% low at this grid) and the rest the lag. So K at onset is within 5% of
+// K_Ic, and J within 8.4% of J_Ic (the 5% on J is met by the computed
+// J, not by the handbook J at this grid and ramp rate). The crack grows
+// straight: the new particles lie within 1.5e-4 h of the crack line.
+TEST(Propagation, EdgeCrackStartsAtToughnessAndGrowsStraight) {
+  constexpr double kW = 1, kA = 0.3, kH = 1.5 * kW, kToughness = 500;  // J/m^2
+  const double e_prime = kRock.plane_strain_modulus();
+  const double sigma_c = std::sqrt(e_prime * kToughness) / (tada_edge_factor(kA / kW) * std::sqrt(kPi * kA));
+  const double transit = 2 * kH / kRock.p_wave_speed(kRock.density);
+  const double ramp_time = 30 * transit;
+  auto config = edge_crack(kW, kA, kH, 40, TimeFunction::table({0, ramp_time}, {0, sigma_c}));
+  // The table is constant after its end: extend the ramp's slope to 1.5 sigma_c.
+  config.tractions[0].normal = config.tractions[1].normal =
+      TimeFunction::table({0, 1.5 * ramp_time}, {0, 1.5 * sigma_c});
+  config.materials[0].toughness = kToughness;
+  config.fracture.propagate = true;
+  config.fracture.check_interval = 10;
+  Solver solid(config);
+  const std::size_t initial = solid.cracks()[0].size();
+  const double dt = solid.stable_dt();
+  double onset = -1;
+  while (solid.time() < 1.5 * ramp_time && solid.cracks()[0].size() < initial + 6) {
+    solid.step(dt);
+    if (onset < 0 && solid.cracks()[0].size() > initial) onset = solid.time();
+  }
+  ASSERT_GT(onset, 0) << "the crack never grew";
+  const double sigma_onset = sigma_c * onset / ramp_time;
+  const double j_handbook = std::pow(sigma_onset / sigma_c, 2) * kToughness;
+  std::printf("edge crack growth onset at sigma = %.4f sigma_c: handbook J there %.4f J_Ic; J computed at onset %.4f J_Ic\n",
+              sigma_onset / sigma_c, j_handbook / kToughness, solid.last_tips().at(0).j / kToughness);
+  // The criterion fires when the computed J reaches J_Ic (not later: the
+  // check interval and the load step are small), and physically at the
+  // handbook load: K at onset within 5% of K_Ic = sqrt(E' J_Ic).
+  EXPECT_NEAR(solid.last_tips().at(0).j / kToughness, 1, 0.05);
+  EXPECT_NEAR(sigma_onset / sigma_c, 1, 0.05);
+  const auto& crack = solid.cracks()[0];
+  double worst = 0;
+  for (std::size_t k = initial; k < crack.size(); ++k) worst = std::max(worst, std::abs(crack.plane()[k].y()));
+  std::printf("grew %zu particles to x = %.4f m; largest distance from the crack line %.3e h\n", crack.size() - initial,
+              crack.plane().back().x(), worst / solid.grid().h);
+  EXPECT_EQ(crack.size(), initial + 6);
+  EXPECT_LT(worst, 1e-3 * solid.grid().h);
+  EXPECT_GT(crack.plane().back().x(), kA + 2.5 * solid.grid().h);
+}
+
+// A pressurised edge crack in the stiffer of two bonded layers, parallel to
+// the interface and a few cells below it, turns towards the softer layer
+// (cracks are drawn to compliant material: the mismatch gives K_II of the
+// sign that kinks the tip towards the soft side). Asserted: the kink angles
+// at growth are positive (counter-clockwise, towards the soft layer above) and
+// the tip ends above the starting line.
+TEST(Propagation, CrackInStiffLayerTurnsTowardsSoftLayer) {
+  constexpr double kL = 2, kDepth = 0.1, kLength = 0.4, kToughness = 200;
+  const double h = kL / 64;
+  SolidConfig c;
+  c.grid.origin = Vec2(-2 * h, -kL / 2 - 2 * h);
+  c.grid.h = h;
+  c.grid.nx = c.grid.ny = 68;
+  const Material stiff{"stiff", 4e10, 0.25, 2500, kToughness};
+  const Material soft{"soft", 1e10, 0.25, 2500, kToughness};
+  c.materials = {stiff, soft};
+  Region lower, upper;
+  lower.kind = upper.kind = Region::Kind::Layer;
+  lower.lo = Vec2(0, -kL / 2);
+  lower.hi = Vec2(kL, 0);
+  lower.material = 0;
+  upper.lo = Vec2(0, 0);
+  upper.hi = Vec2(kL, kL / 2);
+  upper.material = 1;
+  c.regions = {lower, upper};
+  CrackSpec crack;
+  // On a cell-centre line, so that no node lies on the crack.
+  const double y0 = -kDepth - h / 2;
+  const int segments = static_cast<int>(std::lround(2 * kLength / h));
+  for (int k = 0; k <= segments; ++k) crack.points.emplace_back(kLength * k / segments, y0);
+  c.cracks = {crack};
+  c.fracture.propagate = true;
+  c.fracture.check_interval = 20;
+  const double c_p = stiff.p_wave_speed(stiff.density);
+  c.damping.grid_alpha = 2 * kPi * c_p / (4 * kL);
+  c.threads = 2;
+  Solver solid(c);
+  const std::size_t initial = solid.cracks()[0].size();
+  // Pressure for K_I ~ 1.12 p sqrt(pi a) = sqrt(E' J_Ic), reached after 20 transits.
+  const double p_c = std::sqrt(stiff.plane_strain_modulus() * kToughness) / (1.12 * std::sqrt(kPi * kLength));
+  const double ramp_time = 20 * kL / c_p;
+  const double dt = solid.stable_dt();
+  double kink_sum = 0;
+  int checks = 0;
+  while (solid.time() < 3 * ramp_time && solid.cracks()[0].size() < initial + 10) {
+    const double p = 2 * p_c * solid.time() / ramp_time;
+    solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), p));
+    const std::size_t before = solid.cracks()[0].size();
+    solid.step(dt);
+    if (solid.cracks()[0].size() > before) {
+      kink_sum += solid.last_tips().at(0).kink;
+      ++checks;
+    }
+  }
+  const auto& cr = solid.cracks()[0];
+  const double rise = cr.plane().back().y() - y0;
+  std::printf("layered: grew %zu particles, tip at (%.4f, %.4f) m, rise %.3f h towards the soft layer, mean kink %.2f deg\n",
+              cr.size() - initial, cr.plane().back().x(), cr.plane().back().y(), rise / h,
+              checks ? kink_sum / checks * 180 / kPi : 0.0);
+  ASSERT_GE(cr.size(), initial + 8) << "the crack did not grow";
+  EXPECT_GT(kink_sum / checks, 0) << "the tip turned away from the soft layer";
+  EXPECT_GT(rise, 0.05 * h);
+}
+
+}  // namespace
+}  // namespace hfmpm::solid::mpm
