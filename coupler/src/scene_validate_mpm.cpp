@@ -1,4 +1,5 @@
 // Rules for solid.mpm: grid, materials, regions, constraints, tractions.
+#include <cmath>
 #include <set>
 
 #include "scene_checker.hpp"
@@ -62,6 +63,11 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
     }
     if (!mat.has_density_kg_m3()) c.missing(k + "density_kg_m3", "the density (kg/m^3), > 0");
     else c.positive(k + "density_kg_m3", mat.density_kg_m3(), "kg/m^3");
+    if (mat.has_toughness_j_m2() && mat.has_toughness_pa_sqrt_m()) {
+      c.bad(k + "toughness_pa_sqrt_m", text(mat.toughness_pa_sqrt_m()), "unset: toughness_j_m2 is set (give one of them)");
+    }
+    if (mat.has_toughness_j_m2()) c.positive(k + "toughness_j_m2", mat.toughness_j_m2(), "J/m^2");
+    if (mat.has_toughness_pa_sqrt_m()) c.positive(k + "toughness_pa_sqrt_m", mat.toughness_pa_sqrt_m(), "Pa m^0.5");
   }
   if (m.regions_size() == 0) c.missing(key + "regions", "at least one region { material: .. rectangle { .. } }");
   for (int i = 0; i < m.regions_size(); ++i) {
@@ -143,6 +149,15 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   }
   c.non_negative(key + "damping.grid_alpha_per_s", m.damping().grid_alpha_per_s(), "1/s");
   c.range(key + "damping.pic_fraction", m.damping().pic_fraction(), 0, 1, false, "0 (FLIP) to 1 (PIC)");
+  c.non_negative(key + "damping.feedback_q_m2", m.damping().feedback_q_m2(), "m^2");
+  c.non_negative(key + "damping.feedback_target_kinetic_energy_j", m.damping().feedback_target_kinetic_energy_j(), "J/m");
+  const auto& f = m.fracture();
+  c.range(key + "fracture.j_inner_cells", f.j_inner_cells(), 0, 1e3, true, "cells");
+  if (std::isfinite(f.j_inner_cells()) && !(f.j_outer_cells() > f.j_inner_cells() && f.j_outer_cells() <= 1e3)) {
+    c.bad(key + "fracture.j_outer_cells", text(f.j_outer_cells()), "more than j_inner_cells (" + text(f.j_inner_cells()) + ") cells");
+  }
+  c.range(key + "fracture.growth_cells", f.growth_cells(), 0, 1, true, "cells");
+  if (f.check_interval() < 1) c.bad(key + "fracture.check_interval", std::to_string(f.check_interval()), "at least 1 step");
   if (m.threads() < 1 || m.threads() > 64) c.bad(key + "threads", std::to_string(m.threads()), "1 to 64");
 }
 

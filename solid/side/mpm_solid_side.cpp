@@ -55,7 +55,14 @@ class MpmSolidSide final : public coupling::SideModel {
   }
   void publish(protocol::DataFrame& frame) override {
     auto* state = frame.mutable_crack();
-    for (const auto& crack : solver_->cracks()) proto::to_proto(geometry(crack), state->add_cracks());
+    published_.resize(solver_->cracks().size(), 0);
+    for (std::size_t c = 0; c < solver_->cracks().size(); ++c) {
+      const auto& crack = solver_->cracks()[c];
+      auto g = geometry(crack);
+      g.grew = published_[c] != 0 && crack.size() > published_[c];
+      published_[c] = crack.size();
+      proto::to_proto(g, state->add_cracks());
+    }
   }
   void receive(const protocol::DataFrame& frame) override {
     for (const auto& c : frame.fluid().cracks()) {
@@ -108,6 +115,27 @@ class MpmSolidSide final : public coupling::SideModel {
       writer_->points(set + "_above", crack.surface(1));
       writer_->points(set + "_below", crack.surface(-1));
     }
+    if (!solver_->cracks().empty()) {
+      // J and K at every tip (evaluated now: without propagation J is computed only here).
+      const auto tips = solver_->tips();
+      std::vector<Vec2> position;
+      std::vector<double> j, k1, k2, kink;
+      std::vector<std::int32_t> crack_id;
+      for (const auto& tip : tips) {
+        position.push_back(tip.position);
+        j.push_back(tip.j);
+        k1.push_back(tip.k1);
+        k2.push_back(tip.k2);
+        kink.push_back(tip.kink);
+        crack_id.push_back(static_cast<std::int32_t>(tip.crack));
+      }
+      writer_->points("tips", position);
+      writer_->scalar("tips", "j", j);
+      writer_->scalar("tips", "k1", k1);
+      writer_->scalar("tips", "k2", k2);
+      writer_->scalar("tips", "kink_angle", kink);
+      writer_->integer("tips", "crack", crack_id);
+    }
     writer_->end_frame();
   }
 
@@ -131,6 +159,7 @@ class MpmSolidSide final : public coupling::SideModel {
 
   std::optional<mpm::Solver> solver_;
   std::vector<std::optional<TimeFunction>> prescribed_;
+  std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)
   std::optional<output::FrameWriter> writer_;
 };
 
@@ -146,7 +175,10 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   std::map<std::string, int> index;
   for (const auto& m : s.materials()) {
     index[m.name()] = static_cast<int>(c.materials.size());
-    c.materials.push_back({m.name(), m.youngs_modulus_pa(), m.poisson_ratio(), m.density_kg_m3()});
+    mpm::Material mat{m.name(), m.youngs_modulus_pa(), m.poisson_ratio(), m.density_kg_m3()};
+    if (m.has_toughness_j_m2()) mat.toughness = m.toughness_j_m2();
+    if (m.has_toughness_pa_sqrt_m()) mat.toughness = std::pow(m.toughness_pa_sqrt_m(), 2) / mat.plane_strain_modulus();
+    c.materials.push_back(mat);
   }
   for (const auto& r : s.regions()) {
     mpm::Region region;
@@ -199,6 +231,13 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   for (int e : s.silent_edges()) c.silent_edges.push_back(to_edge(static_cast<scene::Edge>(e)));
   c.damping.grid_alpha = s.damping().grid_alpha_per_s();
   c.damping.pic_fraction = s.damping().pic_fraction();
+  c.damping.feedback_q = s.damping().feedback_q_m2();
+  c.damping.feedback_target_ke = s.damping().feedback_target_kinetic_energy_j();
+  c.fracture.inner_cells = s.fracture().j_inner_cells();
+  c.fracture.outer_cells = s.fracture().j_outer_cells();
+  c.fracture.propagate = s.fracture().propagate();
+  c.fracture.growth_cells = s.fracture().growth_cells();
+  c.fracture.check_interval = static_cast<int>(s.fracture().check_interval());
   c.threads = static_cast<int>(s.threads());
   for (const auto& cr : s.cracks()) {
     mpm::CrackSpec spec;

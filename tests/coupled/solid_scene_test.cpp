@@ -23,7 +23,7 @@ TEST(SolidScene, SneddonRunsAndWritesAValidXdmf) {
   EXPECT_EQ(history.values("crack_particles").back(), 21.0);
 
   const auto summary = check_xdmf(out + "/solid.xmf", out + "/solid.h5");  // throws on any problem
-  for (const char* set : {"particles", "crack0", "crack0_above", "crack0_below"}) {
+  for (const char* set : {"particles", "crack0", "crack0_above", "crack0_below", "tips"}) {
     ASSERT_TRUE(summary.grids.count(set)) << set;
   }
   EXPECT_EQ(summary.times.size(), 11u);  // output every 5 ms to 55 ms
@@ -31,6 +31,34 @@ TEST(SolidScene, SneddonRunsAndWritesAValidXdmf) {
   EXPECT_TRUE(summary.grids.at("particles").back().attributes.count("stress_xx"));
   EXPECT_TRUE(summary.grids.at("crack0").back().attributes.count("width"));
   EXPECT_GT(summary.hdf_items, 100u);
+  for (const char* field : {"j", "k1", "k2", "kink_angle"}) {
+    EXPECT_TRUE(summary.grids.at("tips").back().attributes.count(field)) << field;
+  }
+}
+
+// The fracture keys are validated before anything runs, naming key, value and range.
+TEST(SolidScene, BadFractureSettingsAreRefused) {
+  struct Case {
+    std::string set, key, allowed;
+  };
+  const std::vector<Case> cases = {
+      {"solid.mpm.fracture.j_outer_cells=1", "solid.mpm.fracture.j_outer_cells", "more than j_inner_cells"},
+      {"solid.mpm.fracture.growth_cells=1.5", "solid.mpm.fracture.growth_cells", "cells"},
+      {"solid.mpm.fracture.check_interval=0", "solid.mpm.fracture.check_interval", "at least 1 step"},
+      {"solid.mpm.damping.feedback_q_m2=-1", "solid.mpm.damping.feedback_q_m2", "m^2"},
+      {"solid.mpm.materials=[{name: \"rock\" youngs_modulus_pa: 1e10 poisson_ratio: 0.25 density_kg_m3: 2500 "
+       "toughness_j_m2: 1 toughness_pa_sqrt_m: 1e5}]",
+       "solid.mpm.materials[0].toughness_pa_sqrt_m", "give one of them"},
+      {"solid.mpm.materials=[{name: \"rock\" youngs_modulus_pa: 1e10 poisson_ratio: 0.25 density_kg_m3: 2500 "
+       "toughness_j_m2: -1}]",
+       "solid.mpm.materials[0].toughness_j_m2", "J/m^2"},
+  };
+  for (const auto& c : cases) {
+    const auto result = run({bin("hfmpm"), "validate", source("scenarios/sneddon.scene"), "--set", c.set}, 30);
+    EXPECT_EQ(result.exit_code, 2) << c.set;
+    EXPECT_NE(result.err.find(c.key), std::string::npos) << c.set << ": " << result.err;
+    EXPECT_NE(result.err.find(c.allowed), std::string::npos) << c.set << ": " << result.err;
+  }
 }
 
 TEST(SolidScene, ConfinedBlockSettles) {
