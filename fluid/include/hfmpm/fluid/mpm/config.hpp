@@ -1,0 +1,59 @@
+// What a fluid simulation on one crack is built from. Plain C++; the side
+// adapter fills it from the scene. SI units, 2D per unit thickness.
+#pragma once
+
+#include <memory>
+
+#include "hfmpm/fluid/mpm/rheology.hpp"
+#include "hfmpm/time_function.hpp"
+
+namespace hfmpm::fluid::mpm {
+
+// The inlet at the crack mouth (node 0).
+struct InletConfig {
+  enum class Kind { FlowRate, Pressure };
+  Kind kind = Kind::FlowRate;
+  // FlowRate: Q(t), m^2/s, into this crack, as volume at zero pressure
+  // (mass rate rho0 Q). With a symmetry plane at the mouth, the half of the
+  // total rate that enters the simulated wing.
+  TimeFunction flow_rate = TimeFunction::constant(0);
+  // Pressure: p_in(t), Pa (values < 0 act as 0: no suction).
+  TimeFunction pressure = TimeFunction::constant(0);
+  // Virtual pre-opening: crack nodes with arc length <= pre_opening_length
+  // (m; the mouth node always) have an effective width of at least
+  // pre_opening (m), so fluid can enter a closed crack.
+  double pre_opening = 0;
+  double pre_opening_length = 0;
+};
+
+// An optional outlet at the last crack node, held at a pressure: fluid that
+// crosses it leaves the simulation (and enters if the pressure pushes it
+// back). Not for fractures (their tip is closed); for channel-flow
+// verification (steady Poiseuille flow, waves over a base pressure).
+struct OutletConfig {
+  bool enabled = false;
+  TimeFunction pressure = TimeFunction::constant(0);  // Pa
+};
+
+struct FluidConfig {
+  double density = 1000;                     // kg/m^3, rho0, at zero pressure (J = 1)
+  double bulk_modulus = 2.2e9;               // Pa, K at zero pressure (Tait)
+  double tait_c = 0.0894;                    // -, Tait exponent scale (water)
+  double viscosity = 1e-3;                   // Pa s, Newtonian viscosity (used when `rheology` is null)
+  std::shared_ptr<const Rheology> rheology;  // the wall friction law; null: Newtonian(viscosity)
+  double cfl = 0.5;                          // -, dt = cfl * min(particle length, node spacing) / sound speed
+  // m, length of the particles inserted at the inlet (the inlet particle is
+  // split when it reaches twice this). 0: half the mouth element, fixed at
+  // the first set_crack().
+  double particle_length = 0;
+  double flip = 0;  // -, FLIP fraction of the particle velocity update (0 = PIC)
+  // Pressure constant per element, from the volume ratio of the fluid in it
+  // (against volumetric locking, see FluidSolver::element_pressure); false:
+  // each particle's pressure from its own J = F11 F22.
+  bool smooth_jacobian = true;
+  double min_width = 1e-9;  // m, width floor in the drag and in w0 (numerical; the drag is implicit)
+  InletConfig inlet;
+  OutletConfig outlet;
+};
+
+}  // namespace hfmpm::fluid::mpm

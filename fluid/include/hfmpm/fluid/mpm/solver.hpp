@@ -1,0 +1,158 @@
+// 1D MPM of the fluid in one crack (nested-manifold MPM, DESIGN.md 3).
+//
+// Momentum balance. Width-averaged (lubrication) flow in a channel of opening
+// w(s), per unit thickness and per unit length along the crack:
+//   rho w Dv/Dt = -d(p w)/ds + p dw/ds - k(w, v) w v  =  -w dp/ds - k w v,
+// where p dw/ds is the push of the (inclined) crack faces on the slice and
+// k = 12 mu / w^2 for a Newtonian fluid (Rheology). The face term matters: a
+// fluid at rest under a uniform pressure in a tapering crack must stay at rest.
+// Weak form with the hats N_i, the pressure constant over each particle domain
+// [a_p, b_p], the inlet pressure p_in at the mouth and p = 0 beyond the front:
+//   -int w dp/ds N_i ds = sum_p p_p [w N_i]_{a_p}^{b_p} + p_in w(0) N_i(0)
+// (integrate by parts on each particle; the jumps of p between particles are
+// the interface forces). So the internal force is
+//   f_i = sum_p p_p (w(b_p) N_i(b_p) - w(a_p) N_i(a_p)),
+// which in a channel of constant width is the usual CPDI form
+// sum_p p_p V_p Gbar_ip with V_p = l_p w. (Dropping the face term gives
+// sum_p p_p V_p Gbar_ip everywhere, which drives a spurious flow towards the
+// narrow end of a tapering crack at uniform pressure.)
+// Friction: c_i = sum_p Nbar_ip k_p V_p, integrated implicitly on the grid:
+//   v_i^{n+1} = (m_i v_i^n + dt f_i) / (m_i + dt c_i),
+// so vanishing widths near the tip do not limit dt.
+//
+// One step (update stress last):
+//   1. particle state from the current crack: w_p = mean effective width over
+//      [a_p, b_p], F22 = w / w0, J = F11 F22; the pressure from the Tait law
+//      with J limited to <= 1 (no tension), by default one pressure per
+//      element from the volume ratio of the fluid in it (element_pressure(),
+//      against volumetric locking; config smooth_jacobian);
+//   2. P2G with the CPDI weights: m_i, m_i v_i, c_i, f_i (+ the inlet and
+//      outlet boundary forces);
+//   3. grid velocities with the implicit friction;
+//   4. G2P: v_p from the new grid velocities (PIC, or a FLIP blend); the two
+//      ends of each domain move with the grid velocity there (the CPDI
+//      corner update), so neighbours stay contiguous;
+//      F11 <- F11 l^{n+1} / l^n = (1 + Gbar v dt) F11 with Gbar v = dv/ds the
+//      CPDI velocity gradient: the same to first order in dt as
+//      exp(dv/ds dt) F11 (DESIGN.md 3), but consistent with the moved ends;
+//      with the exponential and l = l0 F11, the ends of neighbours would drift
+//      apart, opening gaps and overlaps between particles;
+//   5. inlet (and outlet): the inlet particle is re-extended to the mouth and
+//      given the mass that entered; it is split when it grows long;
+//   6. state and nodal pressures at the end of the step.
+//
+// Known limitations (measured in tests/fluid):
+// - A sudden start (a step in the inlet flow rate, a water hammer of
+//   rho c v >> the viscous pressure) leaves particle-to-particle differences
+//   of J that the element pressure does not see but that are carried with the
+//   fluid (with more particles than elements the split of an element's volume
+//   among its particles is not controlled): nodal pressures then wander by
+//   ~10% until those particles leave. A ramp over a few
+//   tau = rho w^2 / (12 mu) avoids it.
+// - Nodal pressures are a lumped (mass-weighted) projection: first order on
+//   an uneven grid (off by ~ (h_i - h_{i-1}) / 4 times the gradient).
+// - The fluid does not follow the crack's own motion along itself: particles
+//   keep their arc length when the grid moves (no convection of the fluid
+//   with a stretching crack), and curvature forces are ignored.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "hfmpm/exchange.hpp"
+#include "hfmpm/fluid/mpm/config.hpp"
+#include "hfmpm/fluid/mpm/crack_grid.hpp"
+#include "hfmpm/fluid/mpm/eos.hpp"
+#include "hfmpm/fluid/mpm/particles.hpp"
+#include "hfmpm/fluid/mpm/shape.hpp"
+
+namespace hfmpm::fluid::mpm {
+
+class FluidSolver {
+ public:
+  // Throws std::invalid_argument naming a config field that is out of range.
+  explicit FluidSolver(FluidConfig config);
+
+  // The crack (the grid) as the solid published it; call before every step.
+  // Nodes are appended when the crack grows; see CrackGrid::set for what is rejected.
+  void set_crack(const CrackGeometry& crack);
+  // Initial condition: fill [0, front] (m) with fluid at rest at `pressure`
+  // (Pa, >= 0), in particles of about particle_length. Only into an empty crack.
+  void fill(double front, double pressure);
+
+  // One explicit step of dt (s); dt must not exceed stable_dt().
+  void step(double dt);
+  // Advance by dt_total (s) in equal substeps no longer than stable_dt() (the
+  // crack is frozen meanwhile). Returns the number of substeps.
+  int advance(double dt_total);
+  // s, cfl * min(smallest particle length, smallest node spacing) / c, with
+  // c the fastest sound speed of the particles (>= sqrt(K / rho0)).
+  double stable_dt() const;
+
+  double time() const { return t_; }
+  std::uint64_t steps() const { return steps_; }
+  const FluidConfig& config() const { return config_; }
+  const TaitEos& eos() const { return eos_; }
+  const CrackGrid& grid() const { return grid_; }
+  const FluidParticles& particles() const { return particles_; }
+
+  // Output.
+  std::vector<Vec2> particle_positions() const;  // m, centres on the crack polyline
+  // Pa per crack node: mass-weighted CPDI projection of the particle
+  // pressures, >= 0, and 0 at nodes beyond the front; the mouth node carries
+  // the inlet pressure (and a wetted outlet node the outlet pressure).
+  const std::vector<double>& nodal_pressure() const { return nodal_pressure_; }
+  CrackPressure pressure_message() const;
+  // m, arc length of the front (the end of the last particle), at most the crack length; 0 when empty.
+  double front_position() const;
+  // Pa, the pressure held at the mouth: p_in(t), or for a flow-rate inlet
+  // the inlet particle's pressure.
+  double inlet_pressure() const;
+  // m^2/s, zero-pressure volume per second that came in over the last advance() (or step()).
+  double inlet_flux() const { return inlet_flux_; }
+  double injected_volume() const { return injected_mass_ / config_.density; }  // m^2, zero-pressure volume in
+  double injected_mass() const { return injected_mass_; }                      // kg/m, through the mouth (net)
+  double initial_mass() const { return initial_mass_; }                        // kg/m, from fill()
+  double outflow_mass() const { return outflow_mass_; }                        // kg/m, out through the outlet (net)
+  double fluid_mass() const;                                                   // kg/m, sum of particle masses
+  double fluid_volume() const;                                                 // m^2, sum of l w
+  double kinetic_energy() const;                                               // J/m
+
+ private:
+  void update_state(std::size_t p);  // w, F22, p of one particle from the crack
+  void update_state();
+  void element_pressure();              // element-constant pressure (smooth_jacobian)
+  void reset_reference(std::size_t p);  // w0 = w, F11 from the mass (after mass changed)
+  void build_shapes();
+  void p2g();
+  void grid_update(double dt);
+  void g2p(double dt);
+  // inlet.cpp
+  double mouth_pressure() const;  // boundary pressure at the mouth for the force
+  bool seed(double dt);
+  void inlet(double dt);
+  void outlet(double dt);
+  void split_inlet();
+  void merge(std::size_t p);  // merge particle p + 1 into p
+  // output.cpp
+  void project_pressure();
+
+  FluidConfig config_;
+  TaitEos eos_;
+  std::shared_ptr<const Rheology> rheology_;
+  CrackGrid grid_;
+  FluidParticles particles_;
+  ShapeTable shapes_;
+  // nodal fields
+  std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_;
+  std::vector<double> drag_k_, widths_floor_;  // scratch per particle
+  double particle_length_ = 0;                 // m, resolved target length
+  double t_ = 0;
+  std::uint64_t steps_ = 0;
+  double injected_mass_ = 0, initial_mass_ = 0, outflow_mass_ = 0;
+  double inlet_flux_ = 0;
+  bool outlet_wetted_ = false;
+};
+
+}  // namespace hfmpm::fluid::mpm

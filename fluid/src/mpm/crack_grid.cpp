@@ -1,0 +1,89 @@
+#include "hfmpm/fluid/mpm/crack_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "hfmpm/fluid/mpm/shape.hpp"
+
+namespace hfmpm::fluid::mpm {
+namespace {
+
+[[noreturn]] void reject(std::uint32_t crack, const std::string& what) {
+  std::ostringstream out;
+  out << "fluid: crack " << crack << ": " << what;
+  throw std::invalid_argument(out.str());
+}
+
+}  // namespace
+
+void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_opening_length) {
+  const std::size_t n = crack.ids.size();
+  const std::uint32_t id = crack.crack_id;
+  if (!ids_.empty() && id != crack_id_) {
+    reject(id, "this fluid solver runs on crack " + std::to_string(crack_id_) + "; one solver per crack");
+  }
+  if (n < 2) reject(id, "needs at least 2 crack particles to carry fluid, got " + std::to_string(n));
+  if (crack.position.size() != n || crack.width.size() != n) {
+    reject(id, "ids, positions and widths must have the same size (" + std::to_string(n) + ", " +
+                   std::to_string(crack.position.size()) + ", " + std::to_string(crack.width.size()) + ")");
+  }
+  if (n < ids_.size()) {
+    reject(id, "has " + std::to_string(n) + " crack particles, fewer than the " + std::to_string(ids_.size()) +
+                   " it had: crack particles may not disappear");
+  }
+  for (std::size_t i = 0; i < ids_.size(); ++i) {
+    if (crack.ids[i] != ids_[i]) {
+      std::ostringstream out;
+      out << "crack particle " << i << " has id " << crack.ids[i] << " but had id " << ids_[i]
+          << ": ids may only be appended at the tip, never reordered or removed";
+      reject(id, out.str());
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(crack.width[i] >= 0) || !std::isfinite(crack.width[i])) {
+      std::ostringstream out;
+      out << "crack particle " << i << " (id " << crack.ids[i] << ") has width " << crack.width[i]
+          << " m; widths must be finite and >= 0";
+      reject(id, out.str());
+    }
+  }
+  std::vector<double> arc = arc_length(crack.position);
+  double min_spacing = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < n; ++i) {
+    const double h = arc[i] - arc[i - 1];
+    if (!(h > 0) || !std::isfinite(h)) {
+      std::ostringstream out;
+      out << "crack particles " << i - 1 << " and " << i << " (ids " << crack.ids[i - 1] << ", " << crack.ids[i]
+          << ") are " << h << " m apart; the fluid grid needs distinct, finite positions";
+      reject(id, out.str());
+    }
+    min_spacing = std::min(min_spacing, h);
+  }
+  appended_ = n - ids_.size();
+  crack_id_ = id;
+  ids_ = crack.ids;
+  position_ = crack.position;
+  arc_ = std::move(arc);
+  crack_width_ = crack.width;
+  width_ = crack.width;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i == 0 || arc_[i] <= pre_opening_length) width_[i] = std::max(width_[i], pre_opening);
+  }
+  min_spacing_ = min_spacing;
+}
+
+double CrackGrid::width_integral(double a, double b) const { return integrate(arc_, width_, a, b); }
+
+double CrackGrid::interpolate(double s, std::span<const double> values) const {
+  return mpm::interpolate(arc_, values, s);
+}
+
+Vec2 CrackGrid::point_at(double s) const {
+  const HatPoint h = hat_at(arc_, s);
+  return h.n0 * position_[h.node] + h.n1 * position_[h.node + 1];
+}
+
+}  // namespace hfmpm::fluid::mpm

@@ -1,0 +1,164 @@
+// Inlet at the mouth, optional outlet at the last node, and the insertion,
+// splitting and merging of particles there.
+//
+// The inlet particle (particle 0) always starts at the mouth. After each G2P
+// its rear end, which moved with the grid, is put back at s = 0 and the
+// particle is given the mass that crossed the mouth in the step:
+//   flow-rate inlet: dm = rho0 integral_t^{t+dt} Q dt (trapezoid: exact for a
+//     piecewise-linear Q whose kinks fall on step ends). Its pressure follows
+//     from J = rho0 l w / m, so the pressure at the mouth is whatever pushes
+//     rho0 Q into the crack; the mouth is held at that pressure (the well is
+//     in equilibrium with the inlet particle);
+//   pressure inlet: the mouth is held at p_in(t) (a traction p_in w(0) on node
+//     0); the fluid that moved in over [0, a] (a = where the rear end went)
+//     enters at the inlet density rho0 / J(p_in); if the rear end moved out
+//     (a < 0), the part outside leaves with its share of the particle's mass.
+// Mass is conserved exactly: the added masses are summed into
+// injected_mass(), and splits and merges only redistribute mass.
+// When the inlet particle reaches twice particle_length, its front
+// particle_length is released as a new particle (mass shared by volume, so
+// both keep the same J and pressure). An empty crack is seeded with an inlet
+// particle of particle_length: for a flow rate with the first step's mass
+// (it fills at zero pressure, J > 1, until it is full), for a pressure inlet
+// full at the inlet pressure.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "hfmpm/fluid/mpm/solver.hpp"
+
+namespace hfmpm::fluid::mpm {
+
+double FluidSolver::mouth_pressure() const {
+  if (config_.inlet.kind == InletConfig::Kind::Pressure) return std::max(0.0, config_.inlet.pressure(t_));
+  return particles_.size() > 0 ? particles_.pressure[0] : 0.0;
+}
+
+double FluidSolver::inlet_pressure() const { return mouth_pressure(); }
+
+bool FluidSolver::seed(double dt) {
+  const auto& inlet = config_.inlet;
+  const double rho0 = config_.density;
+  const double L = std::min(particle_length_, grid_.length());
+  const bool flow_rate = inlet.kind == InletConfig::Kind::FlowRate;
+  const double q = flow_rate ? 0.5 * (inlet.flow_rate(t_) + inlet.flow_rate(t_ + dt)) : 0.0;
+  const double p_in = flow_rate ? 0.0 : std::max(0.0, inlet.pressure(t_ + dt));
+  if (!(q > 0) && !(p_in > 0)) return false;  // nothing pushes fluid in yet
+  if (grid_.width()[0] <= 0) {
+    std::ostringstream out;
+    out << "fluid: crack " << grid_.crack_id()
+        << ": the mouth is closed (width 0) and inlet.pre_opening is 0, so no fluid can enter; set "
+           "inlet.pre_opening > 0 (a small virtual opening, e.g. 1e-3 of the expected mouth opening)";
+    throw std::invalid_argument(out.str());
+  }
+  const double m = flow_rate ? rho0 * q * dt : rho0 / eos_.volume_ratio(p_in) * grid_.width_integral(0, L);
+  particles_.insert(0, 0.5 * L, L, m, 0.0);
+  reset_reference(0);
+  injected_mass_ += m;
+  return true;
+}
+
+void FluidSolver::inlet(double dt) {
+  auto& P = particles_;
+  const auto& in = config_.inlet;
+  const double rho0 = config_.density;
+  if (P.size() == 0) {
+    if (seed(dt)) split_inlet();
+    return;
+  }
+  // Particles pushed out through the mouth entirely leave the crack.
+  while (P.size() > 0 && P.end(0) <= 0) {
+    injected_mass_ -= P.mass[0];
+    P.erase(0);
+  }
+  if (P.size() == 0) return;
+  const double a = P.start(0), b = P.end(0);
+  double dm = 0;
+  if (in.kind == InletConfig::Kind::FlowRate) {
+    dm = rho0 * 0.5 * (in.flow_rate(t_) + in.flow_rate(t_ + dt)) * dt;
+  } else if (a > 0) {
+    const double p_in = std::max(0.0, in.pressure(t_ + dt));
+    dm = rho0 / eos_.volume_ratio(p_in) * grid_.width_integral(0, a);
+  }
+  if (a < 0 && in.kind == InletConfig::Kind::Pressure) {
+    const double outside = grid_.width_integral(a, 0), all = grid_.width_integral(a, b);
+    dm = -P.mass[0] * (all > 0 ? outside / all : -a / (b - a));
+  }
+  if (!(P.mass[0] + dm > 0)) {
+    std::ostringstream out;
+    out << "fluid: crack " << grid_.crack_id() << ": the inlet withdrew " << -dm << " kg/m in one step, more than the "
+        << P.mass[0] << " kg/m the inlet particle holds";
+    throw std::runtime_error(out.str());
+  }
+  P.s[0] = 0.5 * b;
+  P.length[0] = b;
+  P.mass[0] += dm;
+  injected_mass_ += dm;
+  reset_reference(0);
+  if (P.size() > 1 && P.length[0] < 0.5 * particle_length_) merge(0);  // backflow shortened it
+  split_inlet();
+}
+
+void FluidSolver::split_inlet() {
+  auto& P = particles_;
+  const double L = particle_length_;
+  while (P.length[0] >= 2 * L) {
+    const double b = P.end(0), cut = b - L;
+    const double front = grid_.width_integral(cut, b), all = grid_.width_integral(0, b);
+    const double m_front = P.mass[0] * (all > 0 ? front / all : L / b);
+    P.insert(1, cut + 0.5 * L, L, m_front, P.velocity[0]);
+    P.s[0] = 0.5 * cut;
+    P.length[0] = cut;
+    P.mass[0] -= m_front;
+    reset_reference(0);
+    reset_reference(1);
+  }
+}
+
+void FluidSolver::merge(std::size_t p) {
+  auto& P = particles_;
+  const double a = P.start(p), b = P.end(p + 1);
+  const double m = P.mass[p] + P.mass[p + 1];
+  P.velocity[p] = (P.mass[p] * P.velocity[p] + P.mass[p + 1] * P.velocity[p + 1]) / m;  // momentum conserved
+  P.mass[p] = m;
+  P.s[p] = 0.5 * (a + b);
+  P.length[p] = b - a;
+  P.erase(p + 1);
+  reset_reference(p);
+}
+
+void FluidSolver::outlet(double dt) {
+  auto& P = particles_;
+  if (!config_.outlet.enabled || P.size() == 0) return;
+  const double end = grid_.length();
+  if (!outlet_wetted_) {
+    if (P.end(P.size() - 1) < end) return;
+    outlet_wetted_ = true;
+  }
+  while (P.size() > 1 && P.start(P.size() - 1) >= end) {  // wholly beyond the outlet: gone
+    outflow_mass_ += P.mass.back();
+    P.erase(P.size() - 1);
+  }
+  const std::size_t q = P.size() - 1;
+  const double a = P.start(q), b = P.end(q);
+  if (!(a < end)) {
+    throw std::runtime_error("fluid: the last particle crossed the outlet in one step (fluid leaves too fast)");
+  }
+  double dm = 0;  // mass that leaves
+  if (b > end) {
+    const double outside = grid_.width_integral(end, b), all = grid_.width_integral(a, b);
+    dm = P.mass[q] * (all > 0 ? outside / all : (b - end) / (b - a));
+  } else if (b < end) {
+    const double p_out = std::max(0.0, config_.outlet.pressure(t_ + dt));
+    dm = -config_.density / eos_.volume_ratio(p_out) * grid_.width_integral(b, end);
+  }
+  P.mass[q] -= dm;
+  outflow_mass_ += dm;
+  P.s[q] = 0.5 * (a + end);
+  P.length[q] = end - a;
+  reset_reference(q);
+  if (q > 0 && P.length[q] < 0.5 * particle_length_) merge(q - 1);
+}
+
+}  // namespace hfmpm::fluid::mpm

@@ -1,0 +1,114 @@
+// Initial fill, nodal pressures and what the fluid reports.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "hfmpm/fluid/mpm/solver.hpp"
+
+namespace hfmpm::fluid::mpm {
+
+void FluidSolver::fill(double front, double pressure) {
+  if (grid_.empty()) throw std::logic_error("fluid: set_crack() must be called before fill()");
+  if (particles_.size() > 0)
+    throw std::logic_error("fluid: fill() is an initial condition: the crack already holds fluid");
+  if (!(front > 0) || front > grid_.length() * (1 + 1e-12)) {
+    std::ostringstream out;
+    out << "fluid: fill front " << front << " m must lie in (0, " << grid_.length() << "] m (the crack length)";
+    throw std::invalid_argument(out.str());
+  }
+  if (!(pressure >= 0) || !std::isfinite(pressure)) {
+    throw std::invalid_argument("fluid: fill pressure must be finite and >= 0 Pa, got " + std::to_string(pressure));
+  }
+  const double J = eos_.volume_ratio(pressure);
+  const auto count = static_cast<std::size_t>(std::max(1.0, std::ceil(front / particle_length_ - 1e-9)));
+  const double l = front / static_cast<double>(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const double a = static_cast<double>(k) * l;
+    const double w = grid_.width_integral(a, a + l) / l;
+    if (w < config_.min_width) {
+      std::ostringstream out;
+      out << "fluid: fill: the crack is closed (mean width " << w << " m < min_width) over [" << a << ", " << a + l
+          << "] m; fill only the open part";
+      throw std::invalid_argument(out.str());
+    }
+    const double m = config_.density * l * w / J;  // V0 = V / J at the fill pressure
+    particles_.insert(k, a + 0.5 * l, l, m, 0.0);
+    reset_reference(k);
+    initial_mass_ += m;
+  }
+  outlet_wetted_ = config_.outlet.enabled && front >= grid_.length() * (1 - 1e-12);
+  update_state();
+  project_pressure();
+}
+
+void FluidSolver::project_pressure() {
+  // Mass-weighted CPDI projection p_i = sum Nbar_ip m_p p_p / sum Nbar_ip m_p;
+  // masses never vanish, so every wetted node has a value.
+  const std::size_t n = grid_.size();
+  nodal_pressure_.assign(n, 0.0);
+  if (particles_.size() == 0) return;  // the shapes are current: update_state() built them
+  std::fill(mass_.begin(), mass_.end(), 0.0);
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const CpdiRange r = shapes_.range[p];
+    const double* N = shapes_.weight.data() + shapes_.offset[p];
+    const double m = particles_.mass[p], mp = m * particles_.pressure[p];
+    for (std::size_t k = 0; k < r.count; ++k) {
+      mass_[r.first + k] += N[k] * m;
+      nodal_pressure_[r.first + k] += N[k] * mp;
+    }
+  }
+  const double front = front_position() + 1e-12 * grid_.length();
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool wetted = grid_.arc()[i] <= front && mass_[i] > 0;
+    nodal_pressure_[i] = wetted ? std::max(0.0, nodal_pressure_[i] / mass_[i]) : 0.0;  // lag zone beyond the front
+  }
+  // Where the pressure is held (the mouth, a wetted outlet) the node carries
+  // that boundary value, not the one-sided projection (which is the pressure
+  // about half an element inside).
+  nodal_pressure_[0] = mouth_pressure();
+  if (outlet_wetted_) nodal_pressure_[n - 1] = std::max(0.0, config_.outlet.pressure(t_));
+}
+
+double FluidSolver::front_position() const {
+  if (particles_.size() == 0) return 0.0;
+  return std::min(particles_.end(particles_.size() - 1), grid_.length());
+}
+
+std::vector<Vec2> FluidSolver::particle_positions() const {
+  std::vector<Vec2> x(particles_.size());
+  for (std::size_t p = 0; p < particles_.size(); ++p) x[p] = grid_.point_at(particles_.s[p]);
+  return x;
+}
+
+CrackPressure FluidSolver::pressure_message() const {
+  CrackPressure m;
+  m.crack_id = grid_.crack_id();
+  m.ids = grid_.ids();
+  m.pressure = nodal_pressure_;
+  m.front_position = front_position();
+  m.inlet_flux = inlet_flux_;
+  m.fluid_volume = fluid_volume();
+  return m;
+}
+
+double FluidSolver::fluid_mass() const {
+  double sum = 0;
+  for (double m : particles_.mass) sum += m;
+  return sum;
+}
+
+double FluidSolver::fluid_volume() const {
+  double sum = 0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) sum += particles_.volume(p);
+  return sum;
+}
+
+double FluidSolver::kinetic_energy() const {
+  double sum = 0;
+  for (std::size_t p = 0; p < particles_.size(); ++p)
+    sum += 0.5 * particles_.mass[p] * particles_.velocity[p] * particles_.velocity[p];
+  return sum;
+}
+
+}  // namespace hfmpm::fluid::mpm

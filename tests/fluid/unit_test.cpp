@@ -1,0 +1,259 @@
+// Unit tests of the fluid's pieces.
+// - Tait EOS p = c K (exp((1 - J)/c) - 1): p(1) = 0, dp/dJ(1) = -K (central
+//   difference, truncation error ~ K h^2 / (6 c^2) relative), monotone, the
+//   inverse J(p), no tension.
+// - CPDI in 1D (Sadeghirad et al. 2011): on random non-uniform grids the
+//   weights sum to one, the gradients to zero, and the weights reproduce
+//   linear fields (sum Nbar_i s_i = s_p, sum Gbar_i s_i = 1) for particles
+//   from a fraction of an element to many elements long; the weights equal a
+//   brute-force quadrature of the hats; the clamp beyond the ends.
+// - The crack grid: ids may only be appended; bad geometry is rejected.
+// - The solver's input checks: config ranges, reordered ids, a closed mouth
+//   without a pre-opening.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "channel.hpp"
+#include "hfmpm/fluid/mpm/crack_grid.hpp"
+#include "hfmpm/fluid/mpm/eos.hpp"
+#include "hfmpm/fluid/mpm/rheology.hpp"
+#include "hfmpm/fluid/mpm/shape.hpp"
+#include "hfmpm/fluid/mpm/solver.hpp"
+
+namespace hfmpm::fluid::mpm {
+namespace {
+
+TEST(Tait, ZeroPressureAndBulkModulusAtTheReferenceState) {
+  const TaitEos eos{2.2e9, 0.0894};
+  EXPECT_EQ(eos.pressure(1.0), 0.0);
+  const double h = 1e-5;
+  const double slope = (eos.pressure(1 + h) - eos.pressure(1 - h)) / (2 * h);
+  std::printf("Tait: dp/dJ(1) by central difference = %.9e Pa (-K = %.9e)\n", slope, -eos.bulk_modulus);
+  EXPECT_NEAR(slope / -eos.bulk_modulus, 1.0, 1e-8);  // truncation h^2 / (6 c^2) ~ 2e-9
+  EXPECT_DOUBLE_EQ(eos.slope(1.0), -eos.bulk_modulus);
+}
+
+TEST(Tait, MonotoneInvertibleAndWithoutTension) {
+  const TaitEos eos{2.2e9, 0.0894};
+  double previous = eos.pressure(0.3);
+  for (double J = 0.31; J < 1.5; J += 0.01) {
+    const double p = eos.pressure(J);
+    EXPECT_LT(p, previous) << "J = " << J;
+    previous = p;
+    EXPECT_GE(eos.pressure_no_tension(J), 0.0);
+    EXPECT_NEAR(eos.volume_ratio(p), J, 1e-12);
+  }
+  EXPECT_EQ(eos.pressure_no_tension(1.2), 0.0);
+  EXPECT_EQ(eos.pressure_no_tension(0.99), eos.pressure(0.99));
+  EXPECT_NEAR(eos.sound_speed(1.0, 1000), std::sqrt(2.2e9 / 1000), 1e-9);
+}
+
+TEST(Newtonian, ParallelPlateDrag) {
+  const Newtonian water(1e-3);
+  const std::vector<double> w{1e-3, 2e-4}, v{0.1, -3};
+  std::vector<double> k(2);
+  water.drag(w, v, k);
+  EXPECT_DOUBLE_EQ(k[0], 12e-3 / 1e-6);  // 12 mu / w^2
+  EXPECT_DOUBLE_EQ(k[1], 12e-3 / 4e-8);
+  EXPECT_THROW(Newtonian(-1), std::invalid_argument);
+}
+
+std::vector<double> random_grid(std::mt19937& rng, int cells) {
+  std::uniform_real_distribution<double> spacing(0.05, 2.0);
+  std::vector<double> s{0.0};
+  for (int i = 0; i < cells; ++i) s.push_back(s.back() + spacing(rng));
+  return s;
+}
+
+TEST(Cpdi, PartitionOfUnityZeroGradientSumAndLinearReproduction) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int spanning = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const auto nodes = random_grid(rng, 12);
+    const double L = nodes.back();
+    // Lengths from 1e-4 of the crack to all of it (log-uniform): up to 12 elements.
+    const double l = L * std::pow(10.0, -4 * unit(rng));
+    const double a = (L - l) * unit(rng), b = a + l;
+    std::vector<double> w, g;
+    const CpdiRange r = cpdi_weights(nodes, a, b, w, &g);
+    ASSERT_EQ(w.size(), r.count);
+    if (r.count > 3) ++spanning;
+    double sum = 0, gsum = 0, moment = 0, gmoment = 0;
+    for (std::size_t k = 0; k < r.count; ++k) {
+      const double x = nodes[r.first + k] - 0.5 * (a + b);  // relative to the centre: no cancellation
+      ASSERT_GE(w[k], -1e-15);
+      sum += w[k];
+      gsum += g[k];
+      moment += w[k] * x;
+      gmoment += g[k] * x;
+    }
+    ASSERT_NEAR(sum, 1.0, 1e-13) << "a = " << a << " b = " << b;
+    ASSERT_NEAR(gsum * l, 0.0, 1e-13);
+    ASSERT_NEAR(moment, 0.0, 1e-12 * L);  // sum Nbar_i s_i = s_p
+    ASSERT_NEAR(gmoment, 1.0, 1e-11);     // sum Gbar_i s_i = 1
+  }
+  EXPECT_GT(spanning, 3000);  // many particles spanning several elements were tested
+}
+
+TEST(Cpdi, WeightsAreTheMeanOfTheHatsOverTheDomain) {
+  std::mt19937 rng(5);
+  const auto nodes = random_grid(rng, 8);
+  // A long particle over several elements, partly beyond the tip (clamped).
+  const double a = 0.3 * nodes[1], b = nodes.back() + 0.7;
+  std::vector<double> w;
+  const CpdiRange r = cpdi_weights(nodes, a, b, w);
+  const int q = 400000;  // midpoint rule: error ~ (l/q)^2 at the hats' kinks
+  std::vector<double> brute(nodes.size(), 0.0);
+  for (int k = 0; k < q; ++k) {
+    const HatPoint h = hat_at(nodes, a + (k + 0.5) * (b - a) / q);
+    brute[h.node] += h.n0 / q;
+    brute[h.node + 1] += h.n1 / q;
+  }
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    const double mine = i >= r.first && i < r.first + r.count ? w[i - r.first] : 0.0;
+    EXPECT_NEAR(mine, brute[i], 1e-9) << "node " << i;
+  }
+  // The 0.7 m beyond the tip sits on the tip node: its weight exceeds 0.7 / l.
+  EXPECT_GT(w.back(), 0.7 / (b - a));
+}
+
+TEST(Cpdi, ClampedBeyondTheEnds) {
+  const std::vector<double> nodes{0.0, 1.0, 3.0};
+  std::vector<double> w, g;
+  // Wholly beyond the tip: everything on the tip node, no gradient.
+  auto r = cpdi_weights(nodes, 3.5, 4.0, w, &g);
+  ASSERT_EQ(r.first, 2u);
+  ASSERT_EQ(r.count, 1u);
+  EXPECT_DOUBLE_EQ(w[0], 1.0);
+  EXPECT_DOUBLE_EQ(g[0], 0.0);
+  // Half inside the last element [1, 3], half beyond: [2, 4].
+  w.clear();
+  g.clear();
+  r = cpdi_weights(nodes, 2.0, 4.0, w, &g);
+  ASSERT_EQ(r.first, 1u);
+  // integral of N_1 over [2, 3] = 0.25, of N_2 = 0.75 + 1 (beyond), over l = 2
+  EXPECT_DOUBLE_EQ(w[0], 0.125);
+  EXPECT_DOUBLE_EQ(w[1], 0.875);
+  EXPECT_DOUBLE_EQ(g[0], (0.0 - 0.5) / 2);  // (N_1(4) - N_1(2)) / l
+  EXPECT_DOUBLE_EQ(g[1], (1.0 - 0.5) / 2);
+  // A domain ending on a node does not touch the next hat.
+  w.clear();
+  r = cpdi_weights(nodes, 0.25, 1.0, w);
+  EXPECT_EQ(r.first, 0u);
+  EXPECT_EQ(r.count, 2u);
+}
+
+TEST(Cpdi, IntegralOfALinearFieldIsExact) {
+  const std::vector<double> nodes{0.0, 0.5, 2.0, 2.1}, values{1.0, 3.0, -1.0, 4.0};
+  // Over [0.25, 2.05]: trapezoids on [0.25, 0.5], [0.5, 2], [2, 2.05].
+  const double expected = 0.25 * (2.0 + 3.0) / 2 + 1.5 * (3.0 - 1.0) / 2 + 0.05 * (-1.0 + 1.5) / 2;
+  EXPECT_NEAR(integrate(nodes, values, 0.25, 2.05), expected, 1e-15);
+  // Constant extension outside: 1 m before the mouth at values[0], 1 m beyond the tip at values[3].
+  EXPECT_NEAR(integrate(nodes, values, -1.0, 0.0), 1.0, 1e-15);
+  EXPECT_NEAR(integrate(nodes, values, 2.1, 3.1), 4.0, 1e-15);
+  EXPECT_NEAR(interpolate(nodes, values, 1.25), 1.0, 1e-15);
+}
+
+TEST(CrackGrid, AppendsNodesAndRejectsReorderedOrMissingIds) {
+  CrackGrid grid;
+  auto crack = test::channel(1.0, 4, 1e-3);
+  grid.set(crack, 0, 0);
+  EXPECT_EQ(grid.size(), 5u);
+  EXPECT_DOUBLE_EQ(grid.length(), 1.0);
+  // Growth: two ids appended at the tip.
+  auto grown = test::straight_crack({0, 0.25, 0.5, 0.75, 1.0, 1.1, 1.2}, std::vector<double>(7, 1e-3));
+  grid.set(grown, 0, 0);
+  EXPECT_EQ(grid.size(), 7u);
+  EXPECT_EQ(grid.appended(), 2u);
+  EXPECT_EQ(grid.ids()[6], 106u);
+  // Reordered ids.
+  auto swapped = grown;
+  std::swap(swapped.ids[2], swapped.ids[3]);
+  EXPECT_THROW(grid.set(swapped, 0, 0), std::invalid_argument);
+  // A crack particle disappeared.
+  auto shorter = test::channel(1.0, 4, 1e-3);
+  try {
+    grid.set(shorter, 0, 0);
+    FAIL() << "a crack that lost crack particles was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("may not disappear"), std::string::npos) << e.what();
+  }
+  // Another crack id on the same solver.
+  auto other = grown;
+  other.crack_id = 3;
+  EXPECT_THROW(grid.set(other, 0, 0), std::invalid_argument);
+  // The grid is unchanged by the rejected calls.
+  EXPECT_EQ(grid.size(), 7u);
+}
+
+TEST(CrackGrid, RejectsBadGeometryAndAppliesThePreOpening) {
+  CrackGrid grid;
+  EXPECT_THROW(grid.set(test::straight_crack({0.0}, {1e-3}), 0, 0), std::invalid_argument);
+  EXPECT_THROW(grid.set(test::straight_crack({0.0, 0.5, 0.5}, {1e-3, 1e-3, 0}), 0, 0), std::invalid_argument);
+  EXPECT_THROW(grid.set(test::straight_crack({0.0, 0.5, 1.0}, {1e-3, -1e-6, 0}), 0, 0), std::invalid_argument);
+  // Closed crack with a 1e-4 m pre-opening over the first 0.3 m: nodes 0 and 1 opened.
+  grid.set(test::straight_crack({0.0, 0.25, 0.5, 0.75}, {0, 2e-4, 0, 0}), 1e-4, 0.3);
+  EXPECT_DOUBLE_EQ(grid.width()[0], 1e-4);
+  EXPECT_DOUBLE_EQ(grid.width()[1], 2e-4);  // already wider
+  EXPECT_DOUBLE_EQ(grid.width()[2], 0.0);
+  EXPECT_DOUBLE_EQ(grid.crack_width()[0], 0.0);
+  EXPECT_DOUBLE_EQ(grid.width_integral(0, 0.25), 0.25 * 1.5e-4);
+  // Points on a bent polyline by arc length.
+  auto bent = test::straight_crack({0.0, 1.0, 2.0}, {1e-3, 1e-3, 0}, 0, 7);
+  bent.position[2] = Vec2(1, 1);
+  CrackGrid g2;
+  g2.set(bent, 0, 0);
+  EXPECT_NEAR((g2.point_at(1.5) - Vec2(1, 0.5)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((g2.point_at(-1) - Vec2(0, 0)).norm(), 0.0, 1e-15);
+}
+
+TEST(FlowRateInlet, ClosedMouthWithoutPreOpeningIsAClearError) {
+  FluidConfig c;
+  c.inlet.flow_rate = TimeFunction::constant(1e-4);
+  FluidSolver fluid(c);
+  fluid.set_crack(test::channel(1.0, 10, 0.0));
+  try {
+    fluid.step(1e-6);
+    FAIL() << "fluid entered a closed crack without a pre-opening";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("pre_opening"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PressureInlet, ClosedMouthWithoutPreOpeningIsAClearError) {
+  FluidConfig c;
+  c.inlet.kind = InletConfig::Kind::Pressure;
+  c.inlet.pressure = TimeFunction::constant(1e6);
+  FluidSolver fluid(c);
+  fluid.set_crack(test::channel(1.0, 10, 0.0));
+  EXPECT_THROW(fluid.step(1e-6), std::invalid_argument);
+  // With a pre-opening the fluid enters.
+  c.inlet.pre_opening = 1e-5;
+  FluidSolver opened(c);
+  opened.set_crack(test::channel(1.0, 10, 0.0));
+  opened.step(1e-6);
+  EXPECT_EQ(opened.particles().size(), 1u);
+  EXPECT_GT(opened.fluid_mass(), 0.0);
+  EXPECT_EQ(opened.fluid_mass(), opened.injected_mass());
+}
+
+TEST(FluidSolver, RejectsReorderedIdsAndBadConfig) {
+  FluidConfig c;
+  FluidSolver fluid(c);
+  auto crack = test::channel(1.0, 10, 1e-3);
+  fluid.set_crack(crack);
+  std::swap(crack.ids[1], crack.ids[2]);
+  EXPECT_THROW(fluid.set_crack(crack), std::invalid_argument);
+  FluidConfig bad;
+  bad.cfl = 1.5;
+  EXPECT_THROW(FluidSolver{bad}, std::invalid_argument);
+  bad = FluidConfig{};
+  bad.bulk_modulus = 0;
+  EXPECT_THROW(FluidSolver{bad}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hfmpm::fluid::mpm
