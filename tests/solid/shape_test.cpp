@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "hfmpm/solid/mpm/crack.hpp"
 #include "hfmpm/solid/mpm/shape.hpp"
 
 namespace hfmpm::solid::mpm {
@@ -49,6 +50,29 @@ TEST(Ugimp, TendsToLinearForSmallParticles) {
     EXPECT_NEAR(ugimp_1d(d, h, 1e-7).s, linear_1d(d, h).s, 1e-6);
     EXPECT_NEAR(ugimp_1d(d, h, 1e-7).g, linear_1d(d, h).g, 1e-6);
   }
+}
+
+// Growth adds closed crack particles with fresh ids: at the end (append) or,
+// for an interior crack's start tip, in front (prepend); the others keep
+// their ids, positions and order.
+TEST(Crack, GrowthAtEitherEndKeepsIdsAndStartsClosed) {
+  CrackSpec spec;
+  spec.points = {Vec2(0, 0), Vec2(1, 0), Vec2(2, 0)};
+  spec.start_is_tip = spec.end_is_tip = true;
+  Crack crack(0, spec);
+  crack.surface(1)[1] = Vec2(1, 0.1);
+  crack.surface(-1)[1] = Vec2(1, -0.1);
+  crack.pressure()[1] = 5;
+  crack.append(Vec2(2.5, 0));
+  crack.prepend(Vec2(-0.5, 0));
+  EXPECT_EQ(crack.ids(), (std::vector<std::uint64_t>{4, 0, 1, 2, 3}));
+  EXPECT_EQ(crack.plane().front(), Vec2(-0.5, 0));
+  EXPECT_EQ(crack.plane().back(), Vec2(2.5, 0));
+  EXPECT_EQ(crack.width(0), 0.0);
+  EXPECT_EQ(crack.width(4), 0.0);
+  EXPECT_EQ(crack.pressure(), (std::vector<double>{0, 0, 5, 0, 0}));
+  EXPECT_NEAR(crack.width(2), 0.2, 1e-15);  // the opened particle moved with its data
+  EXPECT_EQ(crack.surface(1)[2], Vec2(1, 0.1));
 }
 
 }  // namespace

@@ -31,11 +31,13 @@ void Crack::append(const Vec2& position) {
 }
 
 void Crack::prepend(const Vec2& position) {
-  ids_.insert(ids_.begin(), next_id_++);
-  plane_.insert(plane_.begin(), position);
-  above_.insert(above_.begin(), position);
-  below_.insert(below_.begin(), position);
-  pressure_.insert(pressure_.begin(), 0.0);
+  append(position);  // then move the new last particle to the front
+  auto to_front = [](auto& v) { std::rotate(v.rbegin(), v.rbegin() + 1, v.rend()); };
+  to_front(ids_);
+  to_front(plane_);
+  to_front(above_);
+  to_front(below_);
+  to_front(pressure_);
 }
 
 Vec2 Crack::normal(std::size_t k) const {

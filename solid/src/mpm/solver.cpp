@@ -97,6 +97,7 @@ void Solver::generate_particles() {
     }
   }
   if (particles_.size() == 0) throw std::invalid_argument("the regions contain no particle: the body is empty");
+  particles_.shrink_to_fit();  // drop push_back's slack: up to half the particle memory
 }
 
 void Solver::build_constraints() {

@@ -166,18 +166,18 @@ void Solver::contact(double dt) {
     // round-off when the node lies on the crack.)
     const Vec2 x = g.position(n);
     double best = std::numeric_limits<double>::infinity();
-    const Crack* nearest = nullptr;
-    std::size_t nearest_k = 0;
-    for (const auto& crack : cracks_) {
-      for (std::size_t k = 0; k < crack.size(); ++k) {
-        const double d = (crack.plane()[k] - x).squaredNorm();
+    std::size_t nearest_c = 0, nearest_k = 0;
+    for (std::size_t c = 0; c < cracks_.size(); ++c) {
+      for (std::size_t k = 0; k < cracks_[c].size(); ++k) {
+        const double d = (cracks_[c].plane()[k] - x).squaredNorm();
         if (d < best) {
           best = d;
-          nearest = &crack;
+          nearest_c = c;
           nearest_k = k;
         }
       }
     }
+    const Crack* nearest = &cracks_[nearest_c];
     const auto& pl = nearest->plane();
     auto distance_to = [&](std::size_t a) {
       const Vec2 ab = pl[a + 1] - pl[a];

@@ -70,7 +70,7 @@ struct Fracture {
   double outer_cells = 5.0;
   bool propagate = false;      // grow tips where J >= J_Ic of the material there
   double growth_cells = 0.5;   // a new crack particle this many cells ahead of the tip
-  int check_interval = 1;      // steps between checks while propagating
+  int check_interval = 10;     // steps between checks while propagating (as the scene default)
 };
 
 struct SolidConfig {

@@ -35,6 +35,15 @@ struct Particles {
     stress.push_back(initial_stress);
     material.push_back(mat);
   }
+  void shrink_to_fit() {
+    x.shrink_to_fit();
+    v.shrink_to_fit();
+    mass.shrink_to_fit();
+    volume.shrink_to_fit();
+    half_size.shrink_to_fit();
+    stress.shrink_to_fit();
+    material.shrink_to_fit();
+  }
 };
 
 }  // namespace hfmpm::solid::mpm
