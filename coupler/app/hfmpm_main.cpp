@@ -8,6 +8,7 @@
 
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
+#include "mpm_fluid_side.hpp"
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
@@ -46,7 +47,7 @@ std::unique_ptr<coupling::SideModel> make_inproc_side(protocol::Role role, const
   if (role == protocol::SOLID) {
     return scene.solid().has_mpm() ? solid::make_mpm_solid_side() : solid::make_prescribed_solid_side();
   }
-  return fluid::make_prescribed_fluid_side();
+  return scene.fluid().has_mpm() ? fluid::make_mpm_fluid_side() : fluid::make_prescribed_fluid_side();
 }
 
 // Sets every unset scalar that has a default, in every message present, so

@@ -154,7 +154,7 @@ std::string Coupler::program_for(const Side& side) const {
   if (side.role == protocol::SOLID) {
     return dir + (scene_.solid().has_mpm() ? "/hfmpm-solid" : "/hfmpm-prescribed-solid");
   }
-  return dir + "/hfmpm-prescribed-fluid";
+  return dir + (scene_.fluid().has_mpm() ? "/hfmpm-fluid" : "/hfmpm-prescribed-fluid");
 }
 
 void Coupler::launch_sides() {

@@ -53,5 +53,7 @@ void check_time_function(Checker& c, const std::string& key, const scene::TimeFu
                          const std::string& unit);
 // Rules for solid.mpm (scene_validate_mpm.cpp).
 void check_mpm_solid(Checker& c, const scene::MpmSolid& m);
+// Rules for fluid.mpm, including how it fits the solid's cracks (scene_validate_fluid.cpp).
+void check_mpm_fluid(Checker& c, const scene::Scene& s);
 
 }  // namespace hfmpm::coupling

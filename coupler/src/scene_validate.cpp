@@ -125,7 +125,7 @@ void check_prescribed_crack(Checker& c, const scene::PrescribedCrack& p) {
   if (!p.has_mouth_opening_m()) c.missing(key + "mouth_opening_m", "the mouth opening w(t) (m), a TimeFunction");
   else check_time_function(c, key + "mouth_opening_m", p.mouth_opening_m(), 0.0, "m");
   if (p.profile() == scene::PrescribedCrack::PROFILE_UNSPECIFIED) {
-    c.bad(key + "profile", "PROFILE_UNSPECIFIED", "ELLIPTIC or UNIFORM");
+    c.bad(key + "profile", "PROFILE_UNSPECIFIED", "ELLIPTIC, UNIFORM or CHANNEL");
   }
   if (!p.has_stable_dt_s()) c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
   else c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
@@ -161,9 +161,12 @@ std::vector<SceneProblem> validate(const scene::Scene& s) {
   }
   if (s.has_fluid()) {
     if (s.fluid().model_case() == scene::Fluid::MODEL_NOT_SET) {
-      c.missing("fluid", "a fluid model: fluid { prescribed_pressure { ... } }, or no fluid block for a dry run");
+      c.missing("fluid", "a fluid model: fluid { mpm { ... } } or fluid { prescribed_pressure { ... } }, or no fluid "
+                         "block for a dry run");
     } else if (s.fluid().has_prescribed_pressure()) {
       check_prescribed_pressure(c, s.fluid().prescribed_pressure());
+    } else if (s.fluid().has_mpm()) {
+      check_mpm_fluid(c, s);
     }
   }
   return c.take();

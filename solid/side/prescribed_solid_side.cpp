@@ -25,8 +25,9 @@ class PrescribedSolidSide final : public coupling::SideModel {
     config.max_length = p.has_max_length_m() ? p.max_length_m() : p.initial_length_m();
     config.spacing = p.spacing_m();
     config.mouth_opening = proto::to_time_function(p.mouth_opening_m());
-    config.profile = p.profile() == scene::PrescribedCrack::UNIFORM ? PrescribedCrackConfig::Profile::Uniform
-                                                                    : PrescribedCrackConfig::Profile::Elliptic;
+    config.profile = p.profile() == scene::PrescribedCrack::UNIFORM   ? PrescribedCrackConfig::Profile::Uniform
+                     : p.profile() == scene::PrescribedCrack::CHANNEL ? PrescribedCrackConfig::Profile::Channel
+                                                                      : PrescribedCrackConfig::Profile::Elliptic;
     config.stable_dt = p.stable_dt_s();
     crack_.emplace(config);
   }

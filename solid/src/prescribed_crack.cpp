@@ -1,5 +1,6 @@
 #include "hfmpm/solid/prescribed_crack.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -18,12 +19,13 @@ void PrescribedCrack::append_particle() {
   const Vec2 direction(std::cos(config_.angle_rad), std::sin(config_.angle_rad));
   const Vec2 normal(-direction.y(), direction.x());  // "above" is to the left of mouth -> tip
   const double s = arc_.empty() ? 0.0 : arc_.back() + h_;
+  const bool channel = config_.profile == PrescribedCrackConfig::Profile::Channel;
   if (!crack_.tip.empty()) crack_.tip.back() = 0;
   crack_.ids.push_back(crack_.ids.size());  // ids 0, 1, 2, ... from the mouth; never reused
   crack_.position.push_back(config_.mouth + s * direction);
   crack_.normal.push_back(normal);
-  crack_.width.push_back(0.0);  // a new particle starts closed
-  crack_.tip.push_back(1);
+  crack_.width.push_back(0.0);  // a new particle starts closed (a channel's is set by update_widths)
+  crack_.tip.push_back(channel ? 0 : 1);
   crack_.grew = true;
   arc_.push_back(s);
   pressure_.push_back(0.0);
@@ -32,6 +34,7 @@ void PrescribedCrack::append_particle() {
 double PrescribedCrack::width_at(double s) const {
   const double w0 = std::max(0.0, config_.mouth_opening(t_));
   const double length = arc_.back();
+  if (config_.profile == PrescribedCrackConfig::Profile::Channel) return s <= length ? w0 : 0.0;
   if (s >= length) return 0.0;
   if (config_.profile == PrescribedCrackConfig::Profile::Uniform) return w0;
   const double r = s / length;
@@ -42,6 +45,10 @@ void PrescribedCrack::update_widths() {
   const double w0 = std::max(0.0, config_.mouth_opening(t_));
   const double length = arc_.back();
   const bool elliptic = config_.profile == PrescribedCrackConfig::Profile::Elliptic;
+  if (config_.profile == PrescribedCrackConfig::Profile::Channel) {
+    std::fill(crack_.width.begin(), crack_.width.end(), w0);
+    return;
+  }
   for (std::size_t i = 0; i < crack_.size(); ++i) {
     const double r = arc_[i] / length;
     crack_.width[i] = arc_[i] >= length ? 0.0 : elliptic ? w0 * std::sqrt(std::max(0.0, 1.0 - r * r)) : w0;

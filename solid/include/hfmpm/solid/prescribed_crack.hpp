@@ -9,7 +9,9 @@
 namespace hfmpm::solid {
 
 struct PrescribedCrackConfig {
-  enum class Profile { Elliptic, Uniform };
+  // Channel: uniform width up to and including the last particle, which is
+  // not a tip (an open far end: a rigid channel for fluid checks).
+  enum class Profile { Elliptic, Uniform, Channel };
   Vec2 mouth = Vec2::Zero();     // m
   double angle_rad = 0;          // direction mouth -> tip
   double initial_length = 1;     // m, > 0

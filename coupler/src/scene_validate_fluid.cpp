@@ -1,0 +1,111 @@
+// Rules for fluid.mpm: fluid constants, inlet, outlet, initial fill, and
+// which of the solid's cracks hold fluid.
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <vector>
+
+#include "scene_checker.hpp"
+
+namespace hfmpm::coupling {
+namespace {
+
+// What the fluid needs to know about each crack of the solid in the scene.
+struct SceneCrack {
+  bool mouth = false;    // the first crack particle is a mouth (not a tip)
+  double length = 0;     // m, initial length along the crack
+};
+
+std::vector<SceneCrack> scene_cracks(const scene::Solid& solid) {
+  std::vector<SceneCrack> out;
+  if (solid.has_prescribed_crack()) {
+    out.push_back({true, solid.prescribed_crack().initial_length_m()});
+  } else if (solid.has_mpm()) {
+    for (const auto& crack : solid.mpm().cracks()) {
+      SceneCrack sc{!crack.start_is_tip(), 0};
+      for (int i = 1; i < std::min(crack.x_m_size(), crack.y_m_size()); ++i) {
+        sc.length += std::hypot(crack.x_m(i) - crack.x_m(i - 1), crack.y_m(i) - crack.y_m(i - 1));
+      }
+      out.push_back(sc);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+void check_mpm_fluid(Checker& c, const scene::Scene& s) {
+  const auto& f = s.fluid().mpm();
+  const std::string key = "fluid.mpm.";
+  c.positive(key + "density_kg_m3", f.density_kg_m3(), "kg/m^3");
+  c.positive(key + "bulk_modulus_pa", f.bulk_modulus_pa(), "Pa");
+  c.positive(key + "tait_c", f.tait_c(), "dimensionless; 0.0894 for water");
+  c.non_negative(key + "viscosity_pa_s", f.viscosity_pa_s(), "Pa s");
+  c.range(key + "cfl", f.cfl(), 0, 1, true, "dimensionless");
+  c.non_negative(key + "particle_length_m", f.particle_length_m(), "m; 0 = half the mouth element");
+  c.range(key + "flip_fraction", f.flip_fraction(), 0, 1, false, "0 = PIC, 1 = FLIP");
+  c.positive(key + "min_width_m", f.min_width_m(), "m");
+  if (f.max_substeps() < 1 || f.max_substeps() > 100000) {
+    c.bad(key + "max_substeps", std::to_string(f.max_substeps()), "1 to 100000 fluid steps per coupled step");
+  }
+
+  if (!f.has_inlet()) {
+    c.missing(key + "inlet", "an inlet: inlet { flow_rate_m2_s { .. } } or inlet { pressure_pa { .. } }");
+  } else {
+    const auto& in = f.inlet();
+    if (in.has_flow_rate_m2_s()) check_time_function(c, key + "inlet.flow_rate_m2_s", in.flow_rate_m2_s(), 0.0, "m^2/s");
+    else if (in.has_pressure_pa()) check_time_function(c, key + "inlet.pressure_pa", in.pressure_pa(), 0.0, "Pa");
+    else c.missing(key + "inlet", "one of flow_rate_m2_s { .. } or pressure_pa { .. }");
+    c.non_negative(key + "inlet.pre_opening_m", in.pre_opening_m(), "m");
+    c.non_negative(key + "inlet.pre_opening_length_m", in.pre_opening_length_m(), "m");
+  }
+  if (f.has_outlet()) {
+    if (!f.outlet().has_pressure_pa()) c.missing(key + "outlet.pressure_pa", "the outlet pressure p(t) (Pa), a TimeFunction");
+    else check_time_function(c, key + "outlet.pressure_pa", f.outlet().pressure_pa(), 0.0, "Pa");
+  }
+
+  // Which cracks hold fluid.
+  const auto cracks = scene_cracks(s.solid());
+  std::vector<std::size_t> filled;
+  if (f.crack_ids_size() == 0) {
+    for (std::size_t i = 0; i < cracks.size(); ++i) {
+      if (cracks[i].mouth) filled.push_back(i);
+    }
+    if (filled.empty() && s.solid().model_case() != scene::Solid::MODEL_NOT_SET) {
+      c.bad(key + "crack_ids", "(empty)",
+            "the ids of the cracks that hold fluid; by default every crack whose first point is a mouth "
+            "(start_is_tip: false), and this scene has none");
+    }
+  }
+  std::set<std::uint32_t> seen;
+  for (int i = 0; i < f.crack_ids_size(); ++i) {
+    const auto id = f.crack_ids(i);
+    const std::string k = key + "crack_ids[" + std::to_string(i) + "]";
+    if (id >= cracks.size()) {
+      c.bad(k, std::to_string(id), "a crack id below " + std::to_string(cracks.size()) + " (the solid's cracks, in order)");
+    } else if (!seen.insert(id).second) {
+      c.bad(k, std::to_string(id), "an id not listed before");
+    } else {
+      filled.push_back(id);
+    }
+  }
+
+  if (f.has_initial_fill()) {
+    const auto& fill = f.initial_fill();
+    if (!fill.has_front_m()) {
+      c.missing(key + "initial_fill.front_m", "the arc length (m) the fluid fills from the mouth, > 0");
+    } else {
+      double shortest = kInf;
+      for (auto id : filled) shortest = std::min(shortest, cracks[id].length);
+      if (std::isfinite(shortest)) {
+        c.range(key + "initial_fill.front_m", fill.front_m(), 0, shortest * (1 + 1e-12), true,
+                "m, at most the initial length of every fluid crack");
+      } else {
+        c.positive(key + "initial_fill.front_m", fill.front_m(), "m");
+      }
+    }
+    c.non_negative(key + "initial_fill.pressure_pa", fill.pressure_pa(), "Pa");
+  }
+}
+
+}  // namespace hfmpm::coupling

@@ -1,0 +1,194 @@
+#include "mpm_fluid_side.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <optional>
+#include <set>
+
+#include "hfmpm/fluid/mpm/solver.hpp"
+#include "hfmpm/output/frame_writer.hpp"
+#include "hfmpm/proto/convert.hpp"
+
+namespace hfmpm::fluid {
+namespace {
+
+class MpmFluidSide final : public coupling::SideModel {
+ public:
+  void setup(const scene::Scene& scene, const std::string& output_dir) override {
+    if (!scene.fluid().has_mpm()) throw coupling::InputError("this side runs fluid.mpm scenes only");
+    const auto& f = scene.fluid().mpm();
+    config_ = to_fluid_config(f);
+    try {
+      mpm::FluidSolver check(config_);  // the library's own range checks, before any crack arrives
+    } catch (const std::invalid_argument& e) {
+      throw coupling::InputError(std::string("fluid.mpm: ") + e.what());
+    }
+    listed_.insert(f.crack_ids().begin(), f.crack_ids().end());
+    if (f.has_initial_fill()) fill_ = f.initial_fill();
+    max_substeps_ = std::max<std::uint32_t>(1, f.max_substeps());
+    if (scene.output().hdf5()) {
+      writer_.emplace(output_dir + "/fluid.h5", "hfmpm fluid: " + scene.name());
+      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+    }
+  }
+
+  // The coupled step may hold max_substeps fluid steps (the fluid subcycles).
+  double stable_dt() const override {
+    double dt = std::numeric_limits<double>::infinity();
+    for (const auto& c : cracks_) dt = std::min(dt, c.solver.stable_dt() * max_substeps_);
+    return dt;
+  }
+
+  void advance(double dt) override {
+    for (auto& c : cracks_) substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
+  }
+
+  void publish(protocol::DataFrame& frame) override {
+    auto* state = frame.mutable_fluid();  // a FluidState even when no crack holds fluid yet
+    for (const auto& c : cracks_) proto::to_proto(c.solver.pressure_message(), state->add_cracks());
+  }
+
+  void receive(const protocol::DataFrame& frame) override {
+    const bool first = !received_;
+    received_ = true;
+    for (const auto& message : frame.crack().cracks()) {
+      const auto geometry = proto::from_proto(message);
+      auto* crack = find(geometry.crack_id);
+      if (!crack) {
+        if (!first) {
+          if (holds_fluid(geometry)) {
+            throw proto::ProtocolError("CrackState: crack " + std::to_string(geometry.crack_id) +
+                                       " appeared after step 0; the fluid builds its cracks at the step-0 exchange");
+          }
+          continue;
+        }
+        if (!holds_fluid(geometry)) continue;
+        cracks_.push_back(FluidCrack{geometry.crack_id, mpm::FluidSolver(config_)});
+        crack = &cracks_.back();
+      }
+      const bool had_grid = !crack->solver.grid().empty();
+      try {
+        crack->solver.set_crack(geometry);
+      } catch (const std::invalid_argument& e) {
+        throw proto::ProtocolError(std::string("CrackState: ") + e.what());
+      }
+      if (had_grid && geometry.grew != (crack->solver.grid().appended() > 0)) {
+        throw proto::ProtocolError("CrackState: crack " + std::to_string(geometry.crack_id) + ": 'grew' is " +
+                                   (geometry.grew ? "true" : "false") + " but " +
+                                   std::to_string(crack->solver.grid().appended()) + " ids were appended");
+      }
+      if (!had_grid && fill_) fill(*crack);
+    }
+    if (first) {
+      for (auto id : listed_) {
+        if (!find(id)) {
+          throw proto::ProtocolError("CrackState at step 0 has no crack " + std::to_string(id) +
+                                     ", which fluid.mpm.crack_ids lists");
+        }
+      }
+    }
+  }
+
+  SideDiagnostics diagnostics() const override {
+    SideDiagnostics d;
+    for (std::size_t i = 0; i < cracks_.size(); ++i) {
+      const auto& s = cracks_[i].solver;
+      if (i == 0) d.inlet_pressure = s.inlet_pressure();
+      d.kinetic_energy += s.kinetic_energy();
+      d.injected_volume += s.injected_volume();  // through the mouth (an initial fill is not injected)
+      d.fluid_volume += s.fluid_volume();
+      d.front_position = std::max(d.front_position, s.front_position());
+      d.fluid_particles += static_cast<std::uint32_t>(s.particles().size());
+    }
+    return d;
+  }
+
+  void write_output(std::uint64_t /*frame*/, double t) override {
+    if (!writer_) return;
+    writer_->begin_frame(t, steps_of_first());
+    for (const auto& c : cracks_) {
+      const auto& s = c.solver;
+      const auto& p = s.particles();
+      const std::string id = std::to_string(c.id);
+      writer_->points("fluid" + id, s.particle_positions());
+      writer_->scalar("fluid" + id, "arc_length", p.s);
+      writer_->scalar("fluid" + id, "length", p.length);
+      writer_->scalar("fluid" + id, "width", p.width);
+      writer_->scalar("fluid" + id, "pressure", p.pressure);
+      writer_->scalar("fluid" + id, "velocity", p.velocity);
+      writer_->scalar("fluid" + id, "mass", p.mass);
+      const auto& g = s.grid();
+      writer_->points("nodes" + id, g.position());
+      writer_->scalar("nodes" + id, "arc_length", g.arc());
+      writer_->scalar("nodes" + id, "width", g.width());
+      writer_->scalar("nodes" + id, "pressure", s.nodal_pressure());
+    }
+    writer_->end_frame();
+  }
+
+ private:
+  struct FluidCrack {
+    std::uint32_t id;
+    mpm::FluidSolver solver;
+  };
+
+  FluidCrack* find(std::uint32_t id) {
+    auto it = std::find_if(cracks_.begin(), cracks_.end(), [&](const FluidCrack& c) { return c.id == id; });
+    return it == cracks_.end() ? nullptr : &*it;
+  }
+  bool holds_fluid(const CrackGeometry& g) const {
+    if (!listed_.empty()) return listed_.count(g.crack_id) > 0;
+    return !g.tip.empty() && g.tip.front() == 0;  // a mouth
+  }
+  void fill(FluidCrack& crack) {
+    try {
+      crack.solver.fill(fill_->front_m(), fill_->pressure_pa());
+    } catch (const std::invalid_argument& e) {
+      throw coupling::InputError(std::string("fluid.mpm.initial_fill: ") + e.what());
+    }
+  }
+  std::uint64_t steps_of_first() const { return cracks_.empty() ? 0 : cracks_.front().solver.steps(); }
+
+  mpm::FluidConfig config_;
+  std::set<std::uint32_t> listed_;
+  std::optional<scene::FluidFill> fill_;
+  std::uint32_t max_substeps_ = 1;
+  std::vector<FluidCrack> cracks_;
+  bool received_ = false;
+  std::uint64_t substeps_ = 0;
+  std::optional<output::FrameWriter> writer_;
+};
+
+}  // namespace
+
+mpm::FluidConfig to_fluid_config(const scene::MpmFluid& f) {
+  mpm::FluidConfig c;
+  c.density = f.density_kg_m3();
+  c.bulk_modulus = f.bulk_modulus_pa();
+  c.tait_c = f.tait_c();
+  c.viscosity = f.viscosity_pa_s();
+  c.cfl = f.cfl();
+  c.particle_length = f.particle_length_m();
+  c.flip = f.flip_fraction();
+  c.smooth_jacobian = f.element_pressure();
+  c.min_width = f.min_width_m();
+  const auto& in = f.inlet();
+  if (in.has_pressure_pa()) {
+    c.inlet.kind = mpm::InletConfig::Kind::Pressure;
+    c.inlet.pressure = proto::to_time_function(in.pressure_pa());
+  } else {
+    c.inlet.kind = mpm::InletConfig::Kind::FlowRate;
+    if (in.has_flow_rate_m2_s()) c.inlet.flow_rate = proto::to_time_function(in.flow_rate_m2_s());
+  }
+  c.inlet.pre_opening = in.pre_opening_m();
+  c.inlet.pre_opening_length = in.pre_opening_length_m();
+  if (f.has_outlet()) {
+    c.outlet.enabled = true;
+    c.outlet.pressure = proto::to_time_function(f.outlet().pressure_pa());
+  }
+  return c;
+}
+
+std::unique_ptr<coupling::SideModel> make_mpm_fluid_side() { return std::make_unique<MpmFluidSide>(); }
+
+}  // namespace hfmpm::fluid

@@ -1,0 +1,18 @@
+// Protocol adapter for the 1D MPM fluid (hfmpm-fluid): one FluidSolver per
+// fluid-filled crack, built from the solid's CrackState at the step-0 exchange.
+#pragma once
+
+#include <memory>
+
+#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/fluid/mpm/config.hpp"
+
+namespace hfmpm::fluid {
+
+inline const char* kMpmFluidName = "hfmpm-fluid";
+std::unique_ptr<coupling::SideModel> make_mpm_fluid_side();
+
+// The solver configuration a validated fluid.mpm block describes (exposed for tests).
+mpm::FluidConfig to_fluid_config(const scene::MpmFluid& scene);
+
+}  // namespace hfmpm::fluid
