@@ -6,10 +6,20 @@ namespace hfmpm::fluid::mpm {
 namespace {
 
 // Element k with s_k <= s < s_{k+1}, clamped to [0, n-2].
+// Lookups come in order along the crack (particles are sorted and each one
+// asks about its two ends), so the element found last, or its neighbour, is
+// nearly always the answer: try those before a binary search ("hunting", as
+// in Press et al., Numerical Recipes 3.1.2). The hint is per thread and only
+// a guess: a hit is verified against the nodes given, so any grid is safe.
 std::size_t element_of(std::span<const double> nodes, double s) {
+  thread_local std::size_t hint = 0;
+  const std::size_t n = nodes.size();
+  for (std::size_t k : {hint, hint + 1, hint - 1}) {  // hint - 1 wraps to SIZE_MAX when hint == 0: fails k < n - 1
+    if (k < n - 1 && nodes[k] <= s && s < nodes[k + 1]) return hint = k;
+  }
   const auto it = std::upper_bound(nodes.begin(), nodes.end(), s);
   const std::size_t k = it == nodes.begin() ? 0 : static_cast<std::size_t>(it - nodes.begin()) - 1;
-  return std::min(k, nodes.size() - 2);
+  return hint = std::min(k, n - 2);
 }
 
 }  // namespace
