@@ -1,12 +1,15 @@
 // Fracture mechanics of the MPM solid against handbook solutions: K from the
-// J-integral for an edge crack and an inclined crack, the kink angle by
-// maximum hoop stress, path independence of J, mirror symmetry of a mode-I
-// problem, and onset and direction of growth.
+// interaction integral for an edge crack and an inclined crack, the kink
+// angle by maximum hoop stress, path independence of J, mirror symmetry of a
+// mode-I problem, and the interaction integral's auxiliary fields.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <complex>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numbers>
 
@@ -15,10 +18,11 @@
 namespace hfmpm::solid::mpm {
 namespace {
 
-// K_I from J of an edge crack, a/W = 0.3, half-height 1.5 W (Tada's strip is
-// long: at half-height >= W the factor is within 1% of the infinite strip).
-// Measured: -3.8% (h = W/20), -2.0% (W/40): first order, as the near-tip
-// field is resolved by a few cells; held to 3% at W/40 as the issue asks.
+// K_I (interaction integral) of an edge crack, a/W = 0.3, half-height 1.5 W
+// (Tada's strip is long: at half-height >= W the factor is within 1% of the
+// infinite strip). Measured: -3.5% (h = W/20), -1.7% (W/40) (sqrt(E' J):
+// -3.6%, -1.7%): first order, as the near-tip field is resolved by a few
+// cells; held to 3% at W/40 as the issue asks.
 TEST(EdgeCrack, StressIntensityFromJMatchesTada) {
   constexpr double kW = 1, kA = 0.3, kH = 1.5 * kW, kSigma = 1e6;
   const double k_exact = tada_edge_factor(kA / kW) * kSigma * std::sqrt(kPi * kA);
@@ -29,7 +33,7 @@ TEST(EdgeCrack, StressIntensityFromJMatchesTada) {
     const auto tips = solid.tips();
     ASSERT_EQ(tips.size(), 1u);
     const double error = (tips[0].k1 - k_exact) / k_exact;
-    std::printf("edge crack a/W = 0.3, h = W/%d: K_I from J %.4e Pa m^0.5, Tada %.4e, error %+.4f, "
+    std::printf("edge crack a/W = 0.3, h = W/%d: K_I %.4e Pa m^0.5, Tada %.4e, error %+.4f, "
                 "|K_II|/K_I %.1e, face work %.3f of J\n",
                 cells, tips[0].k1, k_exact, error, std::abs(tips[0].k2) / tips[0].k1, tips[0].j_faces / tips[0].j);
     EXPECT_LT(std::abs(error), cells >= 40 ? 0.03 : 0.05);
@@ -113,20 +117,32 @@ TEST(EdgeCrack, ModeIStaysSymmetric) {
 namespace hfmpm::solid::mpm {
 namespace {
 
-// Centre crack of length 2a at 45 degrees in a square plate [-10a, 10a]^2
-// under remote tension sigma_yy (Tada 1.4 for the infinite plate):
-//   K_I = sigma sqrt(pi a) cos^2(45) = K_II = sigma sqrt(pi a) sin(45) cos(45),
-// and by maximum hoop stress the crack kinks by -53.13 degrees (Erdogan and
-// Sih 1963). The plate's finite size raises K by about 1% at b = 10a
-// (3.7% at b = 5a, measured on the crack normal to the load).
-// Measured at h = a/5 (J domain 2-5 cells): K_I +4.7%, K_II +9.1%, kink
-// -53.75 degrees; at h = a/8, K_I -0.7%, K_II +5.8%. K_II converges slowly:
-// the crack cuts particles at 45 degrees and the mode split, by the ratio of
-// sliding to opening behind the tip, over-weights sliding. Held to 5% (K_I),
-// 10% (K_II; the issue asks 5%, not met at CI size) and 3 degrees.
+// Centre crack of length 2a at beta = 45 degrees to the x axis in a square
+// plate [-10a, 10a]^2 under remote tension sigma_yy. Reference: the infinite
+// plate (Tada, Paris and Irwin, The Stress Analysis of Cracks Handbook, 1.4;
+// exact): K_I = sigma sqrt(pi a) cos^2(beta), K_II = sigma sqrt(pi a)
+// sin(beta) cos(beta) (sin^2 and sin cos of the angle to the load axis), here
+// both sigma sqrt(pi a) / 2; by maximum hoop stress the crack kinks by
+// -53.13 degrees (Erdogan and Sih 1963). The plate's finite size raises K by
+// about 1% at b = 10a (3.7% at b = 5a, measured on the crack normal to the load).
+// K_I and K_II from the interaction integral, measured at h = a/5 (a/8):
+//   domain 3-7 cells: K_I -0.7% (-0.7%), K_II +0.1% (+0.3%), kink -53.25 (-53.29) deg;
+//   domain 2-5 cells (the default): K_I +6.1% (+4.1%), K_II +6.8% (-0.7%), kink -53.22 (-52.41).
+// The default domain is too close to the tip for an oblique crack: the
+// particles within two cells of a crack crossing the cells at 45 degrees
+// carry stress errors of 10-50% (against Westergaard), and J itself is +14%
+// (sqrt(J E') +6.9%) over it, path-dependent (+8.7%, +6.9%, +3.4% over 1-3,
+// 2-5, 3-7 cells), not converging with h at a fixed domain in cells (a/16:
+// K_I +6.9%), and shifting the crack by a fraction of a cell moves K by +-5%.
+// (The split is not the problem: K_II / K_I from M is 1.006 at a/5, and
+// within 0.95-1.07 over crack shifts and h = a/5, a/8 on either domain.)
+// So the 5% of the issue is held on the 3-7 domain of the same state, the
+// default domain to 8%, and the kink on both to 3 degrees.
+// HFMPM_INCLINED_CELLS=n runs at h = a/n.
 TEST(InclinedCrack, MixedModeAndKinkAngle) {
   constexpr double kA = 1, kB = 10, kSigma = 1e6;
-  const double h = kA / 5;
+  const int cells = std::getenv("HFMPM_INCLINED_CELLS") ? std::atoi(std::getenv("HFMPM_INCLINED_CELLS")) : 5;
+  const double h = kA / cells;
   SolidConfig c;
   c.grid.origin = Vec2(-kB - 2 * h, -kB - 2 * h);
   c.grid.h = h;
@@ -151,15 +167,129 @@ TEST(InclinedCrack, MixedModeAndKinkAngle) {
   settle(solid, 2 * kB, 12);
   const double k_exact = kSigma * std::sqrt(kPi * kA) / 2;
   const double kink_exact = 2 * std::atan((1 - 3.0) / 4);  // -53.13 degrees
-  const auto tips = solid.tips();
-  ASSERT_EQ(tips.size(), 2u);
-  for (const auto& tip : tips) {
-    std::printf("inclined crack, %s tip: K_I %.4e (error %+.4f), K_II %.4e (error %+.4f), kink %.2f deg (exact %.2f)\n",
-                tip.at_end ? "end" : "start", tip.k1, tip.k1 / k_exact - 1, tip.k2, tip.k2 / k_exact - 1,
-                tip.kink * 180 / kPi, kink_exact * 180 / kPi);
-    EXPECT_NEAR(tip.k1 / k_exact, 1, 0.05);
-    EXPECT_NEAR(tip.k2 / k_exact, 1, 0.10);
-    EXPECT_NEAR(tip.kink * 180 / kPi, kink_exact * 180 / kPi, 3);
+  // The same state with the 3-7 cell domain.
+  auto wide = c;
+  wide.fracture.inner_cells = 3;
+  wide.fracture.outer_cells = 7;
+  Solver probe(wide);
+  probe.particles() = solid.particles();
+  probe.cracks() = solid.cracks();
+  for (const bool wide_domain : {true, false}) {
+    const auto tips = wide_domain ? probe.tips() : solid.tips();
+    ASSERT_EQ(tips.size(), 2u);
+    for (const auto& tip : tips) {
+      std::printf("inclined crack h = a/%d, domain %s, %s tip: K_I %.4e (error %+.4f), K_II %.4e (error %+.4f), "
+                  "kink %.2f deg (exact %.2f)\n",
+                  cells, wide_domain ? "3-7" : "2-5", tip.at_end ? "end" : "start", tip.k1, tip.k1 / k_exact - 1,
+                  tip.k2, tip.k2 / k_exact - 1, tip.kink * 180 / kPi, kink_exact * 180 / kPi);
+      const double tolerance = wide_domain ? 0.05 : 0.08;
+      EXPECT_NEAR(tip.k1 / k_exact, 1, tolerance);
+      EXPECT_NEAR(tip.k2 / k_exact, 1, tolerance);
+      EXPECT_NEAR(tip.kink * 180 / kPi, kink_exact * 180 / kPi, 3);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hfmpm::solid::mpm
+
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+// Williams' near-tip displacement in plane strain (tip frame: crack along
+// x1 < 0), written with the half angles from x1, x2 so that it takes complex
+// arguments: the complex step then gives its gradient to round-off.
+template <class T>
+std::array<T, 2> williams_displacement(T x1, T x2, double k1, double k2, double mu, double kappa) {
+  using std::sqrt;
+  const T r = sqrt(x1 * x1 + x2 * x2);
+  const T c = sqrt((r + x1) / (2.0 * r));                                   // cos(theta / 2)
+  const T s = (std::real(x2) < 0 ? -1.0 : 1.0) * sqrt((r - x1) / (2.0 * r));  // sin(theta / 2)
+  const T g = sqrt(r / (2 * kPi)) / (2 * mu);
+  return {g * (k1 * c * (kappa - 1 + 2.0 * s * s) + k2 * s * (kappa + 1 + 2.0 * c * c)),
+          g * (k1 * s * (kappa + 1 - 2.0 * c * c) - k2 * c * (kappa - 1 - 2.0 * s * s))};
+}
+
+// du_i/dx_j by the complex step (exact to round-off).
+Eigen::Matrix2d williams_gradient(const Vec2& x, double k1, double k2, double mu, double kappa) {
+  constexpr double kStep = 1e-30;
+  Eigen::Matrix2d g;
+  for (int j = 0; j < 2; ++j) {
+    const std::complex<double> x1(x.x(), j == 0 ? kStep : 0), x2(x.y(), j == 1 ? kStep : 0);
+    const auto u = williams_displacement(x1, x2, k1, k2, mu, kappa);
+    for (int i = 0; i < 2; ++i) g(i, j) = u[static_cast<std::size_t>(i)].imag() / kStep;
+  }
+  return g;
+}
+
+// Williams' near-tip stress (s11, s22, s12), the textbook form.
+std::array<double, 3> williams_stress(const Vec2& x, double k1, double k2) {
+  const double r = x.norm(), t = std::atan2(x.y(), x.x()), f = 1 / std::sqrt(2 * kPi * r);
+  const double c = std::cos(t / 2), s = std::sin(t / 2), c3 = std::cos(1.5 * t), s3 = std::sin(1.5 * t);
+  return {f * (k1 * c * (1 - s * s3) - k2 * s * (2 + c * c3)), f * (k1 * c * (1 + s * s3) + k2 * s * c * c3),
+          f * (k1 * s * c * c3 + k2 * c * (1 - s * s3))};
+}
+
+// The auxiliary fields' stress is C : sym(grad u) of their displacement
+// (their strain and u_i,1 are derived from the displacement): checked at
+// points all round the tip to 1e-10 of the stress.
+TEST(InteractionIntegral, WilliamsStressMatchesDisplacementGradient) {
+  const double mu = kRock.shear_modulus(), lambda = kRock.lame_lambda(), kappa = 3 - 4 * kRock.poisson_ratio;
+  for (const double r : {1e-3, 0.2, 3.0}) {
+    for (const double theta : {-3.1, -2.0, -0.6, 0.1, 1.3, 2.5, 3.13}) {
+      for (const auto& [k1, k2] : {std::pair{1.0, 0.0}, std::pair{0.0, 1.0}, std::pair{0.7, -1.9}}) {
+        const Vec2 x(r * std::cos(theta), r * std::sin(theta));
+        const Eigen::Matrix2d g = williams_gradient(x, k1, k2, mu, kappa);
+        const double tr = g(0, 0) + g(1, 1);
+        const std::array<double, 3> from_u{lambda * tr + 2 * mu * g(0, 0), lambda * tr + 2 * mu * g(1, 1),
+                                           mu * (g(0, 1) + g(1, 0))};
+        const auto exact = williams_stress(x, k1, k2);
+        const double scale = std::max({std::abs(exact[0]), std::abs(exact[1]), std::abs(exact[2])});
+        for (std::size_t i = 0; i < 3; ++i) {
+          EXPECT_NEAR(from_u[i] / scale, exact[i] / scale, 1e-10)
+              << "r " << r << " theta " << theta << " component " << i;
+        }
+      }
+    }
+  }
+}
+
+// The solver's interaction integral on a prescribed Williams field: every
+// particle of an edge-cracked strip gets grad u of K_I, K_II fields about
+// the tip (x = 0.3, h = W/20, no loads, so no face work). With the field
+// f = K_I f_I + K_II f_II, M^(I) = B(f, f_I) and J = B(f, f) / 2 for the
+// same discrete bilinear form B if the solver's auxiliary stress and u_i,1 are
+// those of f_I and f_II, so K_I K_I' + K_II K_II' = E' J holds to round-off
+// (primes: the returned values) whatever the quadrature error. The returned K
+// match the prescribed ones to the quadrature error of the domain integral
+// (measured -0.11%; held to 0.5%), and the kink follows maximum hoop stress
+// with K_I clamped at 0 (a closed crack under shear kinks by -70.53 degrees).
+TEST(InteractionIntegral, RecoversPrescribedWilliamsField) {
+  Solver solid(edge_crack(1, 0.3, 1.5, 20, TimeFunction::constant(0)));
+  const Vec2 tip_position(0.3, 0);
+  const double mu = kRock.shear_modulus(), kappa = 3 - 4 * kRock.poisson_ratio;
+  const double e_prime = kRock.plane_strain_modulus(), k0 = 1e6;
+  for (const auto& [k1, k2] :
+       {std::pair{k0, 0.0}, std::pair{0.0, k0}, std::pair{k0, -0.5 * k0}, std::pair{-0.4 * k0, k0}}) {
+    auto& p = solid.particles();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      p.grad_u[i] = williams_gradient(p.x[i] - tip_position, k1, k2, mu, kappa);
+    }
+    const auto tips = solid.tips();
+    ASSERT_EQ(tips.size(), 1u);
+    const auto& tip = tips[0];
+    ASSERT_NEAR((tip.position - tip_position).norm(), 0, 1e-12);
+    const double k1_kink = std::max(0.0, k1);
+    const double kink = k2 == 0 ? 0 : 2 * std::atan((k1_kink - std::sqrt(k1_kink * k1_kink + 8 * k2 * k2)) / (4 * k2));
+    std::printf("prescribed K_I %+.2e, K_II %+.2e: returned K_I %+.6e, K_II %+.6e, (K_I K_I' + K_II K_II') / E' J - 1 "
+                "= %.1e, kink %.3f deg (exact %.3f)\n",
+                k1, k2, tip.k1, tip.k2, (k1 * tip.k1 + k2 * tip.k2) / (e_prime * tip.j) - 1, tip.kink * 180 / kPi,
+                kink * 180 / kPi);
+    EXPECT_NEAR((k1 * tip.k1 + k2 * tip.k2) / (e_prime * tip.j), 1, 1e-10);
+    EXPECT_NEAR(tip.k1 / k0, k1 / k0, 0.005);
+    EXPECT_NEAR(tip.k2 / k0, k2 / k0, 0.005);
+    EXPECT_NEAR(tip.kink * 180 / kPi, kink * 180 / kPi, 0.5);
   }
 }
 

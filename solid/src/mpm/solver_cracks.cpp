@@ -151,10 +151,11 @@ namespace hfmpm::solid::mpm {
 
 // Contact (Nairn 2003, section 2.3): where a node has both fields, the crack
 // surfaces there are in contact if the displacement-based opening along the
-// crack normal is negative AND they approach; then the normal components of
+// crack normal is not positive (to 1e-6 h) AND they approach; then the normal components of
 // the two fields' velocities are made equal (frictionless), conserving momentum.
 void Solver::contact(double dt) {
   const auto& g = config_.grid;
+  const double contact_tolerance = 1e-6 * g.h;
   for (int n : active_) {
     const auto u = static_cast<std::size_t>(n);
     const double m0 = nodes_.mass[u], m1 = second_.mass[u];
@@ -197,7 +198,11 @@ void Solver::contact(double dt) {
     // Opening = (u_field0 - u_field1) . n_up; approach = (v_field0 - v_field1) . n_up < 0.
     const double opening = (nodes_.displaced[u] / m0 - second_.displaced[u] / m1).dot(n_up);
     const double approach = (p0 / m0 - p1 / m1).dot(n_up);
-    if (!(opening < 0 && approach < 0)) continue;
+    // Touching counts as contact: a crack closed by an in-situ stress has
+    // zero opening from the first step, and round-off (1e-16 m) must not
+    // switch its contact off (the faces would overlap, then chatter). The
+    // 1e-6 h tolerance is far below any opening of interest.
+    if (!(opening <= contact_tolerance && approach < 0)) continue;
     const Vec2 dp = ((m0 * p1 - m1 * p0) / (m0 + m1)).dot(n_up) * n_up;  // to field 0
     if (dt > 0) {
       velocity_[0][u] += dp / m0;

@@ -30,7 +30,7 @@ struct TipResult {
   Vec2 direction = Vec2::UnitX();  // unit, along the last segment, out of the crack
   double j = 0;          // J/m^2: energy release rate (area integral plus face-load work)
   double j_faces = 0;    // J/m^2: the face-load part of j
-  double k1 = 0, k2 = 0; // Pa m^0.5, from j split by the crack opening near the tip
+  double k1 = 0, k2 = 0; // Pa m^0.5, from the interaction integral (Williams auxiliary fields)
   double kink = 0;       // rad, growth direction by maximum hoop stress, counter-clockwise from direction
   double toughness = 0;  // J/m^2, J_Ic of the material at the tip
   double modulus = 0;    // Pa, plane-strain E' there
