@@ -158,6 +158,9 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   }
   c.range(key + "fracture.growth_cells", f.growth_cells(), 0, 1, true, "cells");
   if (f.check_interval() < 1) c.bad(key + "fracture.check_interval", std::to_string(f.check_interval()), "at least 1 step");
+  if (f.direction() == scene::FractureSpec::DIRECTION_UNSPECIFIED) {
+    c.bad(key + "fracture.direction", "DIRECTION_UNSPECIFIED", "MAX_HOOP_STRESS or STRAIGHT");
+  }
   if (m.threads() < 1 || m.threads() > 64) c.bad(key + "threads", std::to_string(m.threads()), "1 to 64");
 }
 

@@ -182,6 +182,8 @@ mpm::FluidConfig to_fluid_config(const scene::MpmFluid& f) {
   }
   c.inlet.pre_opening = in.pre_opening_m();
   c.inlet.pre_opening_length = in.pre_opening_length_m();
+  c.virtual_opening = f.virtual_opening_m();
+  c.lag = f.lag() == scene::MpmFluid::FRONT_PRESSURE ? mpm::FluidConfig::Lag::Front : mpm::FluidConfig::Lag::Zero;
   if (f.has_outlet()) {
     c.outlet.enabled = true;
     c.outlet.pressure = proto::to_time_function(f.outlet().pressure_pa());

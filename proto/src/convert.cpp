@@ -116,6 +116,8 @@ void to_proto(const CrackPressure& crack, protocol::FluidState::Crack* out) {
   out->set_crack_id(crack.crack_id);
   out->mutable_ids()->Add(crack.ids.begin(), crack.ids.end());
   out->mutable_pressure()->Add(crack.pressure.begin(), crack.pressure.end());
+  out->mutable_stiffness()->Add(crack.stiffness.begin(), crack.stiffness.end());
+  out->mutable_width()->Add(crack.width.begin(), crack.width.end());
   out->set_front_position(crack.front_position);
   out->set_inlet_flux(crack.inlet_flux);
   out->set_fluid_volume(crack.fluid_volume);
@@ -128,6 +130,18 @@ CrackPressure from_proto(const protocol::FluidState::Crack& crack) {
   check_length(type, id, "pressure", crack.pressure(), n);
   check_finite(type, id, "pressure", crack.pressure());
   check_unique_ids(type, id, crack.ids());
+  if (crack.stiffness_size() > 0 || crack.width_size() > 0) {
+    check_length(type, id, "stiffness", crack.stiffness(), n);
+    check_length(type, id, "width", crack.width(), n);
+    check_finite(type, id, "stiffness", crack.stiffness());
+    check_finite(type, id, "width", crack.width());
+    for (double v : crack.stiffness()) {
+      if (v < 0) fail(type, id, "stiffness (-dp/dw) must be >= 0");
+    }
+    for (double v : crack.width()) {
+      if (v < 0) fail(type, id, "width must be >= 0");
+    }
+  }
   for (double v : {crack.front_position(), crack.inlet_flux(), crack.fluid_volume()}) {
     if (!std::isfinite(v)) fail(type, id, "front_position, inlet_flux and fluid_volume must be finite");
   }
@@ -135,6 +149,8 @@ CrackPressure from_proto(const protocol::FluidState::Crack& crack) {
   out.crack_id = id;
   out.ids.assign(crack.ids().begin(), crack.ids().end());
   out.pressure.assign(crack.pressure().begin(), crack.pressure().end());
+  out.stiffness.assign(crack.stiffness().begin(), crack.stiffness().end());
+  out.width.assign(crack.width().begin(), crack.width().end());
   out.front_position = crack.front_position();
   out.inlet_flux = crack.inlet_flux();
   out.fluid_volume = crack.fluid_volume();

@@ -76,7 +76,7 @@ class MpmSolidSide final : public coupling::SideModel {
         throw proto::ProtocolError("FluidState crack " + std::to_string(c.crack_id()) +
                                    ": its ids must be the crack's ids in order (a prefix while the crack grows)");
       }
-      solver_->set_crack_pressure(c.crack_id(), pressure.pressure);
+      solver_->set_crack_pressure(c.crack_id(), pressure.pressure, pressure.stiffness, pressure.width);
     }
   }
   SideDiagnostics diagnostics() const override {
@@ -87,7 +87,7 @@ class MpmSolidSide final : public coupling::SideModel {
       const auto s = arc_length(crack.plane());
       d.crack_length = s.back();
       d.mouth_opening = crack.width(0);
-      for (std::size_t k = 0; k < crack.size(); ++k) d.crack_face_load += crack.pressure()[k] * crack.tributary_length(k);
+      for (std::size_t k = 0; k < crack.size(); ++k) d.crack_face_load += crack.face_pressure(k, solver_->time()) * crack.tributary_length(k);
     }
     for (const auto& crack : solver_->cracks()) d.crack_particles += static_cast<std::uint32_t>(crack.size());
     return d;
@@ -110,7 +110,11 @@ class MpmSolidSide final : public coupling::SideModel {
       }
       writer_->points(set, crack.plane());
       writer_->scalar(set, "width", width);
-      writer_->scalar(set, "pressure", crack.pressure());
+      {
+        std::vector<double> face(crack.size());
+        for (std::size_t k = 0; k < crack.size(); ++k) face[k] = crack.face_pressure(k, solver_->time());
+        writer_->scalar(set, "pressure", face);
+      }
       writer_->vector(set, "normal", normal);
       writer_->points(set + "_above", crack.surface(1));
       writer_->points(set + "_below", crack.surface(-1));
@@ -238,6 +242,8 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   c.fracture.propagate = s.fracture().propagate();
   c.fracture.growth_cells = s.fracture().growth_cells();
   c.fracture.check_interval = static_cast<int>(s.fracture().check_interval());
+  c.fracture.straight = s.fracture().direction() == scene::FractureSpec::STRAIGHT;
+  c.implicit_face_stiffness = s.implicit_face_stiffness();
   c.threads = static_cast<int>(s.threads());
   for (const auto& cr : s.cracks()) {
     mpm::CrackSpec spec;

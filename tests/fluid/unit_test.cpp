@@ -10,6 +10,9 @@
 // - The crack grid: ids may only be appended; bad geometry is rejected.
 // - The solver's input checks: config ranges, reordered ids, a closed mouth
 //   without a pre-opening.
+// - The stiffness -dp/dw the fluid reports (for the solid's implicit face
+//   pressure) against a finite difference of the nodal pressures; the lag
+//   pressure beyond the front (zero, or the front's).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -194,13 +197,19 @@ TEST(CrackGrid, RejectsBadGeometryAndAppliesThePreOpening) {
   EXPECT_THROW(grid.set(test::straight_crack({0.0}, {1e-3}), 0, 0), std::invalid_argument);
   EXPECT_THROW(grid.set(test::straight_crack({0.0, 0.5, 0.5}, {1e-3, 1e-3, 0}), 0, 0), std::invalid_argument);
   EXPECT_THROW(grid.set(test::straight_crack({0.0, 0.5, 1.0}, {1e-3, -1e-6, 0}), 0, 0), std::invalid_argument);
-  // Closed crack with a 1e-4 m pre-opening over the first 0.3 m: nodes 0 and 1 opened.
+  // A 1e-4 m pre-opening over the first 0.3 m is added to nodes 0 and 1 (to
+  // an open node too: the fluid's width always follows the crack's).
   grid.set(test::straight_crack({0.0, 0.25, 0.5, 0.75}, {0, 2e-4, 0, 0}), 1e-4, 0.3);
   EXPECT_DOUBLE_EQ(grid.width()[0], 1e-4);
-  EXPECT_DOUBLE_EQ(grid.width()[1], 2e-4);  // already wider
+  EXPECT_DOUBLE_EQ(grid.width()[1], 3e-4);
   EXPECT_DOUBLE_EQ(grid.width()[2], 0.0);
   EXPECT_DOUBLE_EQ(grid.crack_width()[0], 0.0);
-  EXPECT_DOUBLE_EQ(grid.width_integral(0, 0.25), 0.25 * 1.5e-4);
+  EXPECT_DOUBLE_EQ(grid.width_integral(0, 0.25), 0.25 * 2e-4);
+  // A virtual opening is added everywhere, on top of the pre-opening.
+  grid.set(test::straight_crack({0.0, 0.25, 0.5, 0.75}, {0, 2e-4, 0, 0}), 1e-4, 0.3, 1e-5);
+  EXPECT_DOUBLE_EQ(grid.width()[0], 1.1e-4);
+  EXPECT_DOUBLE_EQ(grid.width()[1], 3.1e-4);
+  EXPECT_DOUBLE_EQ(grid.width()[3], 1e-5);
   // Points on a bent polyline by arc length.
   auto bent = test::straight_crack({0.0, 1.0, 2.0}, {1e-3, 1e-3, 0}, 0, 7);
   bent.position[2] = Vec2(1, 1);
@@ -253,6 +262,68 @@ TEST(FluidSolver, RejectsReorderedIdsAndBadConfig) {
   bad = FluidConfig{};
   bad.bulk_modulus = 0;
   EXPECT_THROW(FluidSolver{bad}, std::invalid_argument);
+}
+
+
+// -dp/dw at each node against a finite difference: a channel filled at
+// 1e5 Pa (K = 2 MPa), every width widened by 1e-7 of itself, one step of
+// 1e-12 s (nothing moves; the state is recomputed). For a uniform change of
+// width the reported stiffness is exact (the row sum of dp_i/dw_j): the
+// difference quotient must match it to the curvature of the Tait law over the
+// step, ~1e-6 relative; held to 1e-4. The mouth of a pressure inlet holds its
+// pressure: stiffness 0 there.
+TEST(FluidSolver, ReportsTheStiffnessOfItsPressureToTheCrackWidth) {
+  for (const auto kind : {InletConfig::Kind::FlowRate, InletConfig::Kind::Pressure}) {
+    FluidConfig c;
+    c.bulk_modulus = 2e6;
+    c.viscosity = 0.01;
+    c.inlet.kind = kind;
+    c.inlet.flow_rate = TimeFunction::constant(0);
+    c.inlet.pressure = TimeFunction::constant(1e5);
+    const double w = 1e-3;
+    FluidSolver fluid(c);
+    fluid.set_crack(test::channel(1.0, 20, w));
+    fluid.fill(1.0, 1e5);
+    fluid.step(1e-12);
+    const auto p0 = fluid.nodal_pressure();
+    const auto s0 = fluid.nodal_stiffness();
+    const double dw = 1e-7 * w;
+    fluid.set_crack(test::channel(1.0, 20, w + dw));
+    fluid.step(1e-12);
+    const auto p1 = fluid.nodal_pressure();
+    for (std::size_t i = 1; i + 1 < p0.size(); ++i) {
+      const double measured = -(p1[i] - p0[i]) / dw;
+      EXPECT_NEAR(s0[i] / measured, 1, 1e-4) << "node " << i;
+    }
+    // K_t J / w at 1e5 Pa: K e^{(1 - J)/c} J / w.
+    const double J = fluid.eos().volume_ratio(1e5);
+    EXPECT_NEAR(s0[10], -fluid.eos().slope(J) * J / w, 1e-9 * s0[10]);
+    if (kind == InletConfig::Kind::Pressure) EXPECT_EQ(s0[0], 0.0);
+    else EXPECT_GT(s0[0], 0.0);
+  }
+}
+
+// Beyond the front: zero pressure (vapour), or with Lag::Front the pressure
+// of the fluid at the front; no stiffness there either way.
+TEST(FluidSolver, LagPressureBeyondTheFront) {
+  for (const auto lag : {FluidConfig::Lag::Zero, FluidConfig::Lag::Front}) {
+    FluidConfig c;
+    c.bulk_modulus = 2e6;
+    c.inlet.flow_rate = TimeFunction::constant(0);
+    c.lag = lag;
+    FluidSolver fluid(c);
+    fluid.set_crack(test::channel(1.0, 20, 1e-3));
+    fluid.fill(0.5, 1e5);
+    fluid.step(1e-12);
+    const auto& p = fluid.nodal_pressure();
+    const auto& s = fluid.nodal_stiffness();
+    const double p_front = fluid.particles().pressure.back();
+    EXPECT_NEAR(p_front, 1e5, 1.0);
+    for (std::size_t i = 11; i < p.size(); ++i) {
+      EXPECT_EQ(p[i], lag == FluidConfig::Lag::Front ? p_front : 0.0) << "node " << i;
+      EXPECT_EQ(s[i], 0.0);
+    }
+  }
 }
 
 }  // namespace

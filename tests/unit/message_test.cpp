@@ -448,6 +448,34 @@ TEST(CrackPressureConvert, RoundTripIsExact) {
   EXPECT_EQ(out.fluid_volume, in.fluid_volume);
 }
 
+TEST(CrackPressureConvert, StiffnessAndWidthRoundTripAndAreChecked) {
+  auto in = sample_pressure();
+  in.stiffness = {2.0e9, 1.5e9, 0.0, 0.0};
+  in.width = {1e-3, 8e-4, 2e-4, 0.0};
+  protocol::FluidState::Crack m;
+  hfmpm::proto::to_proto(in, &m);
+  const auto out = hfmpm::proto::from_proto(m);
+  EXPECT_EQ(out.stiffness, in.stiffness);
+  EXPECT_EQ(out.width, in.width);
+  // Optional: absent in a message without them.
+  protocol::FluidState::Crack plain;
+  hfmpm::proto::to_proto(sample_pressure(), &plain);
+  EXPECT_TRUE(hfmpm::proto::from_proto(plain).stiffness.empty());
+  // Both or neither, one per id, finite, >= 0.
+  auto only_stiffness = m;
+  only_stiffness.clear_width();
+  EXPECT_THAT(from_proto_error(only_stiffness), HasSubstr("'width'"));
+  auto short_stiffness = m;
+  short_stiffness.mutable_stiffness()->RemoveLast();
+  EXPECT_THAT(from_proto_error(short_stiffness), HasSubstr("'stiffness'"));
+  auto negative = m;
+  negative.set_stiffness(1, -1.0);
+  EXPECT_THAT(from_proto_error(negative), HasSubstr("stiffness (-dp/dw) must be >= 0"));
+  auto nan_width = m;
+  nan_width.set_width(2, kNaN);
+  EXPECT_THAT(from_proto_error(nan_width), HasSubstr("width[2]"));
+}
+
 TEST(CrackPressureConvert, LengthMismatchNamesPressure) {
   protocol::FluidState::Crack m;
   hfmpm::proto::to_proto(sample_pressure(), &m);

@@ -19,7 +19,7 @@ namespace {
 
 }  // namespace
 
-void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_opening_length) {
+void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_opening_length, double virtual_opening) {
   const std::size_t n = crack.ids.size();
   const std::uint32_t id = crack.crack_id;
   if (!ids_.empty() && id != crack_id_) {
@@ -70,7 +70,8 @@ void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_o
   crack_width_ = crack.width;
   width_ = crack.width;
   for (std::size_t i = 0; i < n; ++i) {
-    if (i == 0 || arc_[i] <= pre_opening_length) width_[i] = std::max(width_[i], pre_opening);
+    width_[i] += virtual_opening;
+    if (i == 0 || arc_[i] <= pre_opening_length) width_[i] += pre_opening;
   }
   min_spacing_ = min_spacing;
 }

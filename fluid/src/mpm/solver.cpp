@@ -31,12 +31,13 @@ FluidSolver::FluidSolver(FluidConfig config) : config_(std::move(config)) {
           ">= 0 m");
   require(c.inlet.pre_opening_length >= 0 && std::isfinite(c.inlet.pre_opening_length), "inlet.pre_opening_length",
           c.inlet.pre_opening_length, ">= 0 m");
+  require(c.virtual_opening >= 0 && std::isfinite(c.virtual_opening), "virtual_opening", c.virtual_opening, ">= 0 m");
   eos_ = TaitEos{c.bulk_modulus, c.tait_c};
   rheology_ = c.rheology ? c.rheology : std::make_shared<const Newtonian>(c.viscosity);
 }
 
 void FluidSolver::set_crack(const CrackGeometry& crack) {
-  grid_.set(crack, config_.inlet.pre_opening, config_.inlet.pre_opening_length);
+  grid_.set(crack, config_.inlet.pre_opening, config_.inlet.pre_opening_length, config_.virtual_opening);
   if (particle_length_ == 0) {
     particle_length_ = config_.particle_length > 0 ? config_.particle_length : 0.5 * (grid_.arc()[1] - grid_.arc()[0]);
   }

@@ -30,6 +30,12 @@ struct CrackPressure {
   std::uint32_t crack_id = 0;
   std::vector<std::uint64_t> ids;  // crack-particle ids, same order as the geometry
   std::vector<double> pressure;    // Pa, >= 0, 0 beyond the front
+  // Optional (empty, or one per id): -dp/dw (Pa/m, >= 0) at each crack
+  // particle and the crack widths (m) the pressures were computed from. The
+  // solid then applies p - stiffness (w - width) for its current width w and
+  // treats the change over its step implicitly.
+  std::vector<double> stiffness;
+  std::vector<double> width;
   double front_position = 0;       // m, arc length from the mouth
   double inlet_flux = 0;           // m^2/s
   double fluid_volume = 0;         // m^2

@@ -174,8 +174,9 @@ void Solver::step(double dt) {
     p2g<true>();
     contact(0.0);  // on the extrapolated momenta
     edge_loads();
-    crack_loads();
+    crack_loads(dt);
     grid_update(dt);
+    if (config_.implicit_face_stiffness) implicit_face_stiffness(dt);
     contact(dt);  // on the updated momenta, forces made consistent
     g2p<true>(dt);
     move_crack_surfaces(dt);

@@ -81,17 +81,17 @@ void for_side_nodes(const Solver& solver, const Grid& g, const NodalFields* fiel
   for (int c = 0; c < count; ++c) visit(node[c], field[c], weight[c] / total);
 }
 
-void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressure) {
-  auto& target = cracks_.at(c).pressure();
-  for (std::size_t k = 0; k < target.size(); ++k) target[k] = k < pressure.size() ? pressure[k] : 0.0;
+void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
+                                const std::vector<double>& stiffness, const std::vector<double>& width) {
+  cracks_.at(c).receive_pressure(t_, pressure, stiffness, width);
 }
 
-void Solver::crack_loads() {
+void Solver::crack_loads(double dt) {
   const auto& g = config_.grid;
   const NodalFields* fields[2] = {&nodes_, &second_};
   for (const auto& crack : cracks_) {
     for (std::size_t k = 0; k < crack.size(); ++k) {
-      const double p = crack.pressure()[k];
+      const double p = crack.face_pressure(k, t_ + dt);  // at the end of the step (see implicit_face_stiffness)
       if (p == 0) continue;
       // Pressure opens the crack: +n into the field above, -n into the field below.
       const Vec2 force = p * crack.tributary_length(k) * crack.normal(k);
@@ -100,6 +100,80 @@ void Solver::crack_loads() {
           (f ? second_ : nodes_).force[static_cast<std::size_t>(nd)] += side * w * force;
         });
       }
+    }
+  }
+}
+
+// Implicit face stiffness. The face pressure p - s (w - w_ref) is a spring
+// of stiffness s (Pa/m) across the crack; near a fluid-filled tip s ~ K / w
+// is far stiffer than the solid, and applied explicitly it is unstable for
+// dt above about sqrt(rho h w / K) (the fluid's stiffness against the mass of
+// the face nodes), which for K = 1e7 Pa, w = 0.1 mm is 50x below the solid's
+// own step. So the change of the pressure over this step, -s dw with
+// dw = dt (v_above - v_below) . n at the new velocities, is taken
+// implicitly, node by node (backward Euler for the spring, row-sum lumped):
+// at a node with one field above and one below the crack, with
+// k = sum over crack particles of (lumped weight x tributary length x s),
+//   r_new = r / (1 + dt^2 k (1/m_above + 1/m_below)),  r = (v_above - v_below) . n,
+// by equal and opposite impulses (momentum conserved). The explicit part
+// (crack_loads) uses the current width, so over the steps the faces carry
+// the fluid's pressure at their actual width; only the approach to it is
+// damped where the spring is stiff.
+void Solver::implicit_face_stiffness(double dt) {
+  const auto& g = config_.grid;
+  const NodalFields* fields[2] = {&nodes_, &second_};
+  struct FaceNode {
+    int node = -1;
+    int field[2] = {-1, -1};  // [0] above, [1] below
+    double k[2] = {0, 0};     // N/m per m of width change
+    Vec2 normal = Vec2::Zero();
+    bool conflict = false;
+  };
+  std::vector<FaceNode> faces;
+  if (face_slot_.size() != nodes_.mass.size()) face_slot_.assign(nodes_.mass.size(), -1);
+  for (const auto& crack : cracks_) {
+    for (std::size_t k = 0; k < crack.size(); ++k) {
+      const double s = crack.pressure_stiffness()[k];
+      if (s <= 0 || crack.face_pressure(k, t_ + dt) <= 0) continue;
+      const double weight = s * crack.tributary_length(k);
+      const Vec2 n = crack.normal(k);
+      for (int side : {1, -1}) {
+        const int slot = side > 0 ? 0 : 1;
+        for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
+          int& slot_of_node = face_slot_[static_cast<std::size_t>(nd)];
+          if (slot_of_node < 0) {
+            slot_of_node = static_cast<int>(faces.size());
+            faces.push_back({});
+            faces.back().node = nd;
+          }
+          FaceNode* it = &faces[static_cast<std::size_t>(slot_of_node)];
+          if (it->field[slot] >= 0 && it->field[slot] != f) it->conflict = true;
+          it->field[slot] = f;
+          it->k[slot] += w * weight;
+          if (side > 0) it->normal += w * weight * n;
+        });
+      }
+    }
+  }
+  for (const auto& e : faces) face_slot_[static_cast<std::size_t>(e.node)] = -1;
+  for (const auto& e : faces) {
+    const int fa = e.field[0], fb = e.field[1];
+    if (e.conflict || fa < 0 || fb < 0 || fa == fb || e.normal.squaredNorm() == 0) continue;
+    const auto u = static_cast<std::size_t>(e.node);
+    const double ma = fields[fa]->mass[u], mb = fields[fb]->mass[u];
+    const Vec2 n = e.normal.normalized();
+    const double a = dt * dt * 0.5 * (e.k[0] + e.k[1]);
+    const double inverse_mass = 1 / ma + 1 / mb;
+    const double r = (velocity_[fa][u] - velocity_[fb][u]).dot(n);
+    const double impulse = (r / (1 + a * inverse_mass) - r) / inverse_mass;  // on the field above, along n
+    velocity_[fa][u] += impulse / ma * n;
+    velocity_[fb][u] -= impulse / mb * n;
+    acceleration_[fa][u] += impulse / (ma * dt) * n;
+    acceleration_[fb][u] -= impulse / (mb * dt) * n;
+    for (int f : {fa, fb}) {
+      const std::uint8_t fixed = (f ? second_ : nodes_).fixed[u];
+      if (fixed & 1) velocity_[f][u].x() = acceleration_[f][u].x() = 0;
+      if (fixed & 2) velocity_[f][u].y() = acceleration_[f][u].y() = 0;
     }
   }
 }

@@ -20,8 +20,8 @@ struct InletConfig {
   // Pressure: p_in(t), Pa (values < 0 act as 0: no suction).
   TimeFunction pressure = TimeFunction::constant(0);
   // Virtual pre-opening: crack nodes with arc length <= pre_opening_length
-  // (m; the mouth node always) have an effective width of at least
-  // pre_opening (m), so fluid can enter a closed crack.
+  // (m; the mouth node always) are pre_opening (m) wider for the fluid than
+  // the crack, so fluid can enter a closed crack.
   double pre_opening = 0;
   double pre_opening_length = 0;
 };
@@ -51,6 +51,23 @@ struct FluidConfig {
   // (against volumetric locking, see FluidSolver::element_pressure); false:
   // each particle's pressure from its own J = F11 F22.
   bool smooth_jacobian = true;
+  // Virtual opening (m) added to the crack's width at every node, grown ones
+  // included: the fluid can always enter the closed crack ahead of its
+  // front (a thin film instead of a lag). Without it a segment the crack
+  // grew is shut by the confining stress, the fluid cannot enter it (zero
+  // width, infinite drag), and the tip advances only under a pressure far
+  // above the zero-lag solution's. Its volume (virtual_opening x length)
+  // stays in the fluid.
+  double virtual_opening = 0;
+  // Pressure on the crack between the fluid front and the tip (the lag):
+  // Zero (vapour pressure, DESIGN.md 3), or Front: the pressure of the
+  // fluid at the front (the zero-lag closure of the KGD solutions, valid for
+  // t >> 12 mu E'^2 / sigma0^3). With growth in steps of half a cell, a dry
+  // segment at zero pressure is shut by the confining stress until the net
+  // pressure is several times the zero-lag one (the step is much longer than
+  // the physical lag); Front lets the fluid's pressure reach the tip.
+  enum class Lag { Zero, Front };
+  Lag lag = Lag::Zero;
   double min_width = 1e-9;  // m, width floor in the drag and in w0 (numerical; the drag is implicit)
   InletConfig inlet;
   OutletConfig outlet;

@@ -25,10 +25,14 @@ class CrackGrid {
   // fewer than 2 crack particles, arrays of different sizes, a non-finite or
   // negative width, coincident crack particles, a different crack id, or ids
   // that were reordered or removed.
-  // Nodes with arc length <= pre_opening_length (m; always node 0) get an
-  // effective width of at least pre_opening (m): a virtual opening that lets
-  // fluid enter a closed mouth.
-  void set(const CrackGeometry& crack, double pre_opening, double pre_opening_length);
+  // Nodes with arc length <= pre_opening_length (m; always node 0) are
+  // pre_opening (m) wider for the fluid than the crack: a virtual opening
+  // that lets fluid enter a closed mouth. It is added (not a floor) so that
+  // the fluid's width always follows the crack's: under a floor the fluid
+  // sits in a rigid virtual channel until the crack opens past it, its
+  // pressure rises with no relief, and the coupled faces chatter.
+  // Every node is virtual_opening (m) wider still.
+  void set(const CrackGeometry& crack, double pre_opening, double pre_opening_length, double virtual_opening = 0);
 
   bool empty() const { return ids_.empty(); }
   std::size_t size() const { return ids_.size(); }

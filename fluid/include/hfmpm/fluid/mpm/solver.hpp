@@ -103,6 +103,12 @@ class FluidSolver {
   // pressures, >= 0, and 0 at nodes beyond the front; the mouth node carries
   // the inlet pressure (and a wetted outlet node the outlet pressure).
   const std::vector<double>& nodal_pressure() const { return nodal_pressure_; }
+  // Pa/m per crack node, -dp/dw: how fast the nodal pressure falls as the
+  // crack opens there (the fluid's tangent bulk modulus K_t J over the width;
+  // 0 where the pressure does not follow the width). The solid uses it to
+  // treat the pressure's change over its own step implicitly (the explicit
+  // coupling of a stiff fluid is otherwise unstable: DESIGN.md 3, docs/fluid.md).
+  const std::vector<double>& nodal_stiffness() const { return nodal_stiffness_; }
   CrackPressure pressure_message() const;
   // m, arc length of the front (the end of the last particle), at most the crack length; 0 when empty.
   double front_position() const;
@@ -145,7 +151,7 @@ class FluidSolver {
   FluidParticles particles_;
   ShapeTable shapes_;
   // nodal fields
-  std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_;
+  std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_, nodal_stiffness_;
   std::vector<double> drag_k_, widths_floor_;  // scratch per particle
   double particle_length_ = 0;                 // m, resolved target length
   double t_ = 0;

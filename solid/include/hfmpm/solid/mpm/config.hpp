@@ -71,6 +71,10 @@ struct Fracture {
   bool propagate = false;      // grow tips where J >= J_Ic of the material there
   double growth_cells = 0.5;   // a new crack particle this many cells ahead of the tip
   int check_interval = 10;     // steps between checks while propagating (as the scene default)
+  // Mode I by symmetry (a crack on a symmetry line, as in KGD): grow straight
+  // on, driven by the mode-I part of J only; K_II there is discretization
+  // noise (the side tests put a crack lying on a grid line on one side).
+  bool straight = false;
 };
 
 struct SolidConfig {
@@ -86,6 +90,11 @@ struct SolidConfig {
   Damping damping;
   std::vector<CrackSpec> cracks;
   Fracture fracture;
+  // Where the fluid gives its stiffness -dp/dw, the change of the face
+  // pressure over a step is taken implicitly at the nodes the crack cuts
+  // (solver_cracks.cpp). Off: the pressure is explicit, which is unstable
+  // for dt above about sqrt(rho h w / K_fluid).
+  bool implicit_face_stiffness = true;
   int threads = 1;
 };
 

@@ -36,6 +36,13 @@ struct TipResult {
   double modulus = 0;    // Pa, plane-strain E' there
 };
 
+// J/m^2: the energy release rate that drives growth, J without the share of
+// a negative K_I (a crack closed in compression): J (max(K_I, 0)^2 + K_II^2)
+// / (K_I^2 + K_II^2); with mode_one_only (straight growth by symmetry) the
+// K_II^2 term is left out of the numerator. A tip grows when it reaches the
+// toughness.
+double growth_energy(const TipResult& tip, bool mode_one_only = false);
+
 class Solver {
  public:
   explicit Solver(SolidConfig config);
@@ -66,8 +73,12 @@ class Solver {
   // Which field of `node` a point at `from` uses: 1 if the segment between
   // them crosses a crack an odd number of times, else 0.
   int field_of(const Vec2& from, const Vec2& node) const;
-  // Crack-face pressure, Pa, per crack particle of crack c (resized to the crack).
-  void set_crack_pressure(std::size_t c, const std::vector<double>& pressure);
+  // Crack-face pressure, Pa, per crack particle of crack c (a prefix of the
+  // crack; the rest get 0). Optionally the fluid's stiffness -dp/dw (Pa/m)
+  // and the widths (m) the pressure was computed from (both the pressure's
+  // size, or empty): the faces then carry p - stiffness (w - width).
+  void set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
+                          const std::vector<double>& stiffness = {}, const std::vector<double>& width = {});
 
   // J, K_I, K_II and the kink angle at every tip, evaluated now (one pass
   // over the particles near the tips). Quasi-static J: no kinetic terms.
@@ -95,7 +106,8 @@ class Solver {
   void g2p(double dt);
   // Cracks (solver_cracks.cpp)
   bool near_crack(const Vec2& x) const;
-  void crack_loads();
+  void crack_loads(double dt);
+  void implicit_face_stiffness(double dt);
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
@@ -126,6 +138,7 @@ class Solver {
   std::uint32_t epoch_ = 0;
   double t_ = 0;
   std::uint64_t steps_ = 0;
+  std::vector<int> face_slot_;  // scratch of implicit_face_stiffness: node -> entry, -1
   std::uint64_t contacts_ = 0;
   double min_mass_ = 0;  // nodes lighter than this get zero velocity
 };
