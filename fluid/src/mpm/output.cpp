@@ -45,58 +45,74 @@ void FluidSolver::fill(double front, double pressure) {
 void FluidSolver::project_pressure() {
   // Mass-weighted CPDI projection p_i = sum Nbar_ip m_p p_p / sum Nbar_ip m_p;
   // masses never vanish, so every wetted node has a value.
-  // The stiffness -dp/dw_i projects each particle's stiffness K_t J / w_p
-  // (K_t J = -J dp/dJ its tangent bulk modulus, w_p its width) the same way:
-  // a change dw of the widths around a particle changes its J by -J dw / w_p
-  // and its pressure by K_t J dw / w_p, so this is the row sum of
-  // dp_i/dw_j, an upper bound of the local stiffness. (Dividing the
-  // projected K_t J by the node's width instead underestimates it several
-  // fold near the front, where the particles are much narrower than the
-  // open node behind them, and the coupling then went unstable.) Zero where
-  // the pressure does not depend on the crack's width: cavitated fluid
-  // (p = 0), beyond the front, and where a boundary holds the pressure.
   const std::size_t n = grid_.size();
   nodal_pressure_.assign(n, 0.0);
-  nodal_stiffness_.assign(n, 0.0);
   if (particles_.size() == 0) return;  // the shapes are current: update_state() built them
   std::fill(mass_.begin(), mass_.end(), 0.0);
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     const CpdiRange r = shapes_.range[p];
     const double* N = shapes_.weight.data() + shapes_.offset[p];
-    const double pressure = particles_.pressure[p];
-    const double m = particles_.mass[p], mp = m * pressure;
-    double stiffness = 0;  // Pa/m, K_t J / w_p
-    if (pressure > 0) {
-      const double J = eos_.volume_ratio(pressure);
-      stiffness = -eos_.slope(J) * J / std::max(particles_.width[p], config_.min_width);
-    }
+    const double m = particles_.mass[p], mp = m * particles_.pressure[p];
     for (std::size_t k = 0; k < r.count; ++k) {
       mass_[r.first + k] += N[k] * m;
       nodal_pressure_[r.first + k] += N[k] * mp;
-      nodal_stiffness_[r.first + k] += N[k] * m * stiffness;
     }
   }
   const double front = front_position() + 1e-12 * grid_.length();
   for (std::size_t i = 0; i < n; ++i) {
     const bool wetted = grid_.arc()[i] <= front && mass_[i] > 0;
     nodal_pressure_[i] = wetted ? std::max(0.0, nodal_pressure_[i] / mass_[i]) : 0.0;  // lag zone beyond the front
-    nodal_stiffness_[i] = wetted && nodal_pressure_[i] > 0 ? nodal_stiffness_[i] / mass_[i] : 0.0;
+  }
+  if (config_.lag == FluidConfig::Lag::Front) {
+    const double p_front = particles_.pressure[particles_.size() - 1];
+    for (std::size_t i = 0; i < n; ++i) {
+      if (grid_.arc()[i] > front) nodal_pressure_[i] = p_front;
+    }
   }
   // Where the pressure is held (the mouth, a wetted outlet) the node carries
   // that boundary value, not the one-sided projection (which is the pressure
   // about half an element inside).
-  if (config_.lag == FluidConfig::Lag::Front) {
-    const double p_front = particles_.pressure[particles_.size() - 1];
-    for (std::size_t i = 0; i < n; ++i) {
-      if (grid_.arc()[i] > front) nodal_pressure_[i] = p_front;  // no stiffness: no fluid there
+  nodal_pressure_[0] = mouth_pressure();
+  if (outlet_wetted_) nodal_pressure_[n - 1] = std::max(0.0, config_.outlet.pressure(t_));
+}
+
+std::vector<double> FluidSolver::nodal_stiffness() const {
+  // The stiffness -dp/dw_i projects each particle's stiffness K_t J / w_p
+  // (K_t J = -J dp/dJ its tangent bulk modulus, w_p its width) as the
+  // pressure is projected: a change dw of the widths around a particle
+  // changes its J by -J dw / w_p and its pressure by K_t J dw / w_p, so this
+  // is the row sum of dp_i/dw_j, an upper bound of the local stiffness.
+  // (Dividing the projected K_t J by the node's width instead underestimates
+  // it several fold near the front, where the particles are much narrower
+  // than the open node behind them, and the coupling then went unstable.)
+  // Zero where the pressure does not depend on the crack's width: cavitated
+  // fluid (p = 0), beyond the front, and where a boundary holds the pressure.
+  // Computed when asked (once per exchange), not every fluid step.
+  const std::size_t n = grid_.size();
+  std::vector<double> stiffness(n, 0.0), mass(n, 0.0);
+  if (particles_.size() == 0) return stiffness;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const CpdiRange r = shapes_.range[p];
+    const double* N = shapes_.weight.data() + shapes_.offset[p];
+    const double pressure = particles_.pressure[p], m = particles_.mass[p];
+    double k = 0;  // Pa/m, K_t J / w_p
+    if (pressure > 0) {
+      const double J = eos_.volume_ratio(pressure);
+      k = -eos_.slope(J) * J / std::max(particles_.width[p], config_.min_width);
+    }
+    for (std::size_t j = 0; j < r.count; ++j) {
+      mass[r.first + j] += N[j] * m;
+      stiffness[r.first + j] += N[j] * m * k;
     }
   }
-  nodal_pressure_[0] = mouth_pressure();
-  if (config_.inlet.kind == InletConfig::Kind::Pressure) nodal_stiffness_[0] = 0;
-  if (outlet_wetted_) {
-    nodal_pressure_[n - 1] = std::max(0.0, config_.outlet.pressure(t_));
-    nodal_stiffness_[n - 1] = 0;
+  const double front = front_position() + 1e-12 * grid_.length();
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool wetted = grid_.arc()[i] <= front && mass[i] > 0;
+    stiffness[i] = wetted && nodal_pressure_[i] > 0 ? stiffness[i] / mass[i] : 0.0;
   }
+  if (config_.inlet.kind == InletConfig::Kind::Pressure) stiffness[0] = 0;
+  if (outlet_wetted_) stiffness[n - 1] = 0;
+  return stiffness;
 }
 
 double FluidSolver::front_position() const {
@@ -115,7 +131,7 @@ CrackPressure FluidSolver::pressure_message() const {
   m.crack_id = grid_.crack_id();
   m.ids = grid_.ids();
   m.pressure = nodal_pressure_;
-  m.stiffness = nodal_stiffness_;
+  m.stiffness = nodal_stiffness();
   m.width = grid_.crack_width();
   m.front_position = front_position();
   m.inlet_flux = inlet_flux_;

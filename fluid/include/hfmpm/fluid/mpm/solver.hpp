@@ -108,7 +108,7 @@ class FluidSolver {
   // 0 where the pressure does not follow the width). The solid uses it to
   // treat the pressure's change over its own step implicitly (the explicit
   // coupling of a stiff fluid is otherwise unstable: DESIGN.md 3, docs/fluid.md).
-  const std::vector<double>& nodal_stiffness() const { return nodal_stiffness_; }
+  std::vector<double> nodal_stiffness() const;  // computed when called (once per exchange)
   CrackPressure pressure_message() const;
   // m, arc length of the front (the end of the last particle), at most the crack length; 0 when empty.
   double front_position() const;
@@ -151,7 +151,7 @@ class FluidSolver {
   FluidParticles particles_;
   ShapeTable shapes_;
   // nodal fields
-  std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_, nodal_stiffness_;
+  std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_;
   std::vector<double> drag_k_, widths_floor_;  // scratch per particle
   double particle_length_ = 0;                 // m, resolved target length
   double t_ = 0;
