@@ -11,7 +11,8 @@ mode=${1:-run}
 case "$mode" in run|test|build) ;; *) echo "usage: $0 run|test|build" >&2; exit 2 ;; esac
 
 packages=(build-essential cmake pkg-config libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
-          libeigen3-dev libhdf5-dev libgtest-dev libgmock-dev python3)
+          libeigen3-dev libhdf5-dev libgtest-dev libgmock-dev python3
+          python3-numpy python3-matplotlib python3-h5py)  # the last three: tools/kgd_plot.py
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -87,7 +87,7 @@ class MpmSolidSide final : public coupling::SideModel {
       const auto s = arc_length(crack.plane());
       d.crack_length = s.back();
       d.mouth_opening = crack.width(0);
-      for (std::size_t k = 0; k < crack.size(); ++k) d.crack_face_load += crack.face_pressure(k, solver_->time()) * crack.tributary_length(k);
+      for (std::size_t k = 0; k < crack.size(); ++k) d.crack_face_load += crack.face_pressure(k) * crack.tributary_length(k);
     }
     for (const auto& crack : solver_->cracks()) d.crack_particles += static_cast<std::uint32_t>(crack.size());
     return d;
@@ -112,7 +112,7 @@ class MpmSolidSide final : public coupling::SideModel {
       writer_->scalar(set, "width", width);
       {
         std::vector<double> face(crack.size());
-        for (std::size_t k = 0; k < crack.size(); ++k) face[k] = crack.face_pressure(k, solver_->time());
+        for (std::size_t k = 0; k < crack.size(); ++k) face[k] = crack.face_pressure(k);
         writer_->scalar(set, "pressure", face);
       }
       writer_->vector(set, "normal", normal);

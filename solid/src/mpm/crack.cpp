@@ -30,7 +30,6 @@ void Crack::append(const Vec2& position) {
   pressure_.push_back(0.0);
   stiffness_.push_back(0.0);
   reference_width_.push_back(0.0);
-  rate_.push_back(0.0);
 }
 
 void Crack::prepend(const Vec2& position) {
@@ -43,7 +42,6 @@ void Crack::prepend(const Vec2& position) {
   to_front(pressure_);
   to_front(stiffness_);
   to_front(reference_width_);
-  to_front(rate_);
 }
 
 Vec2 Crack::normal(std::size_t k) const {
@@ -62,34 +60,21 @@ double Crack::tributary_length(std::size_t k) const {
 
 double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(normal(k))); }
 
-void Crack::receive_pressure(double t, const std::vector<double>& pressure, const std::vector<double>& stiffness,
+void Crack::receive_pressure(const std::vector<double>& pressure, const std::vector<double>& stiffness,
                              const std::vector<double>& width) {
   const bool stiff = !stiffness.empty() && stiffness.size() == pressure.size() && width.size() == pressure.size();
-  const double elapsed = t - received_t_;
   for (std::size_t k = 0; k < size(); ++k) {
     const bool given = k < pressure.size();
-    const double p = given ? pressure[k] : 0.0;
-    const double s = given && stiff ? stiffness[k] : 0.0;
-    const double w = given && stiff ? width[k] : 0.0;
-    // The fluid's own pressure rate at fixed width: the change of pressure
-    // less the part the change of width explains. Only between two
-    // pressures both above zero with a stiffness (not across cavitation).
-    double rate = 0;
-    if (s > 0 && stiffness_[k] > 0 && p > 0 && pressure_[k] > 0 && elapsed > 0) {
-      rate = ((p - pressure_[k]) + s * (w - reference_width_[k])) / elapsed;
-    }
-    pressure_[k] = p;
-    stiffness_[k] = s;
-    reference_width_[k] = w;
-    rate_[k] = rate;
+    pressure_[k] = given ? pressure[k] : 0.0;
+    stiffness_[k] = given && stiff ? stiffness[k] : 0.0;
+    reference_width_[k] = given && stiff ? width[k] : 0.0;
   }
-  received_t_ = t;
 }
 
-double Crack::face_pressure(std::size_t k, double t) const {
+double Crack::face_pressure(std::size_t k) const {
   const double p = pressure_[k], s = stiffness_[k];
   if (s == 0 || p == 0) return p;
-  return std::max(0.0, p + rate_[k] * (t - received_t_) - s * (width(k) - reference_width_[k]));
+  return std::max(0.0, p - s * (width(k) - reference_width_[k]));
 }
 
 void Crack::prepare(double extension, double tip_tolerance) {

@@ -265,7 +265,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
     if (q == 0) continue;
     const Vec2 t = (crack.plane()[b] - crack.plane()[a]).normalized();
     const Vec2 n_up(-t.y(), t.x());
-    Vec2 load = 0.5 * (crack.face_pressure(a, t_) + crack.face_pressure(b, t_)) * n_up;
+    Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
     const int region = region_at(mid);
     if (region >= 0) {
       const Voigt& s0 = config_.regions[static_cast<std::size_t>(region)].initial_stress;

@@ -174,7 +174,7 @@ void Solver::step(double dt) {
     p2g<true>();
     contact(0.0);  // on the extrapolated momenta
     edge_loads();
-    crack_loads(dt);
+    crack_loads();
     grid_update(dt);
     if (config_.implicit_face_stiffness) implicit_face_stiffness(dt);
     contact(dt);  // on the updated momenta, forces made consistent

@@ -83,15 +83,15 @@ void for_side_nodes(const Solver& solver, const Grid& g, const NodalFields* fiel
 
 void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
                                 const std::vector<double>& stiffness, const std::vector<double>& width) {
-  cracks_.at(c).receive_pressure(t_, pressure, stiffness, width);
+  cracks_.at(c).receive_pressure(pressure, stiffness, width);
 }
 
-void Solver::crack_loads(double dt) {
+void Solver::crack_loads() {
   const auto& g = config_.grid;
   const NodalFields* fields[2] = {&nodes_, &second_};
   for (const auto& crack : cracks_) {
     for (std::size_t k = 0; k < crack.size(); ++k) {
-      const double p = crack.face_pressure(k, t_ + dt);  // at the end of the step (see implicit_face_stiffness)
+      const double p = crack.face_pressure(k);
       if (p == 0) continue;
       // Pressure opens the crack: +n into the field above, -n into the field below.
       const Vec2 force = p * crack.tributary_length(k) * crack.normal(k);
@@ -134,7 +134,7 @@ void Solver::implicit_face_stiffness(double dt) {
   for (const auto& crack : cracks_) {
     for (std::size_t k = 0; k < crack.size(); ++k) {
       const double s = crack.pressure_stiffness()[k];
-      if (s <= 0 || crack.face_pressure(k, t_ + dt) <= 0) continue;
+      if (s <= 0 || crack.face_pressure(k) <= 0) continue;
       const double weight = s * crack.tributary_length(k);
       const Vec2 n = crack.normal(k);
       for (int side : {1, -1}) {

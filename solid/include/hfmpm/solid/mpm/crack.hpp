@@ -35,15 +35,12 @@ class Crack {
   std::vector<double>& pressure_stiffness() { return stiffness_; }
   const std::vector<double>& pressure_stiffness() const { return stiffness_; }
   std::vector<double>& reference_width() { return reference_width_; }
-  // Take a new fluid pressure received at time t (s); see Solver::set_crack_pressure.
-  void receive_pressure(double t, const std::vector<double>& pressure, const std::vector<double>& stiffness,
+  // Take a new fluid pressure; see Solver::set_crack_pressure.
+  void receive_pressure(const std::vector<double>& pressure, const std::vector<double>& stiffness,
                         const std::vector<double>& width);
-  // Pa, the pressure on the faces at time t (s) and the current width w:
-  // max(0, p + rate (t - t_received) - stiffness (w - reference width)),
-  // rate the fluid's own pressure rate at fixed width (from the last two
-  // pressures received; 0 without stiffness).
-  double face_pressure(std::size_t k, double t) const;
-  double face_pressure(std::size_t k) const { return face_pressure(k, received_t_); }
+  // Pa, the pressure on the faces at the current width w:
+  // max(0, p - stiffness (w - reference width)).
+  double face_pressure(std::size_t k) const;
   bool start_is_tip() const { return start_is_tip_; }
   bool end_is_tip() const { return end_is_tip_; }
 
@@ -79,8 +76,6 @@ class Crack {
   std::vector<Vec2> plane_, above_, below_;
   std::vector<double> pressure_;  // Pa, on the faces, per crack particle
   std::vector<double> stiffness_, reference_width_;  // Pa/m and m, per crack particle
-  std::vector<double> rate_;                         // Pa/s, per crack particle
-  double received_t_ = 0;                            // s, time of the last pressure received
   std::uint64_t next_id_ = 0;
   // Side-test geometry: the plane polyline with extended mouth ends.
   std::vector<Vec2> path_;

@@ -106,7 +106,7 @@ class Solver {
   void g2p(double dt);
   // Cracks (solver_cracks.cpp)
   bool near_crack(const Vec2& x) const;
-  void crack_loads(double dt);
+  void crack_loads();
   void implicit_face_stiffness(double dt);
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the

@@ -1,0 +1,143 @@
+#!/usr/bin/python3
+"""Compare a KGD run with the plane-strain hydraulic fracture solutions and plot it.
+
+    /usr/bin/python3 tools/kgd_plot.py RUN_DIR --E 1e7 --nu 0.25 --mu 0.01 --Q 2.5e-4 \
+        --KIc 100 --sigma0 1e5 [--t0 0.05] [--out RUN_DIR/kgd.png]
+
+RUN_DIR is an `hfmpm run --out` directory (history.csv; solid.h5 and fluid.h5 for the
+profiles at the end). Q is the TOTAL injection rate (both wings; the simulated wing takes
+Q/2). Writes one PNG with four panels (mouth opening, half-length and net inlet pressure
+against time with the M-vertex, K-vertex and Geertsma-de Klerk curves; width and net pressure
+along the crack at the end) and prints the errors against the vertex the dimensionless
+toughness Km selects, at the history rows where the crack is at least three times its
+initial length. Uses Debian's python3-numpy, python3-matplotlib and python3-h5py
+(tools/bootstrap.sh installs them).
+
+References (E' = E/(1-nu^2), mu' = 12 mu, K' = sqrt(32/pi) K_Ic, Q total):
+  M-vertex (Spence and Sharp 1985; Adachi and Detournay 2002; Detournay 2004):
+    l = 0.6152 (E' Q^3 t^4 / mu')^(1/6), w0 = 1.126 (mu' Q^3 t^2 / E')^(1/6),
+    p0 = 0.545 (mu' E'^2 / t)^(1/3)
+  K-vertex (uniform pressure, Sneddon's ellipse, LEFM, volume balance):
+    l = 2 / pi^(2/3) (E' Q t / K')^(2/3), w0 = pi^(-1/3) (K'^2 Q t / E'^2)^(1/3),
+    p0 = pi^(1/3) / 8 (K'^4 / (E' Q t))^(1/3)
+  Geertsma and de Klerk (1969), q = Q/2 into one wing, G = E / (2 (1 + nu)):
+    w0 = 1.32 (8 (1 - nu) mu q^3 / G)^(1/6) t^(1/3), l = 0.48 (8 G q^3 / ((1 - nu) mu))^(1/6) t^(2/3)
+  Dimensionless toughness Km = K' / (E'^3 mu' Q)^(1/4): M-vertex for Km <~ 1, K-vertex for Km >~ 4.
+t0 shifts the simulated time for a ramped injection (t_eff = t - t0; half the ramp time).
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+
+def vertices(E, nu, mu, Q, KIc, t):
+    ep = E / (1 - nu * nu)
+    mup = 12 * mu
+    kp = math.sqrt(32 / math.pi) * KIc
+    m = (0.6152 * (ep * Q ** 3 * t ** 4 / mup) ** (1 / 6), 1.126 * (mup * Q ** 3 * t * t / ep) ** (1 / 6),
+         0.545 * (mup * ep * ep / t) ** (1 / 3))
+    k = (2 / math.pi ** (2 / 3) * (ep * Q * t / kp) ** (2 / 3), math.pi ** (-1 / 3) * (kp * kp * Q * t / ep ** 2) ** (1 / 3),
+         math.pi ** (1 / 3) / 8 * (kp ** 4 / (ep * Q * t)) ** (1 / 3))
+    q = Q / 2
+    G = E / (2 * (1 + nu))
+    gdk = (0.48 * (8 * G * q ** 3 / ((1 - nu) * mu)) ** (1 / 6) * t ** (2 / 3),
+           1.32 * (8 * (1 - nu) * mu * q ** 3 / G) ** (1 / 6) * t ** (1 / 3))
+    return m, k, gdk
+
+
+def km(E, nu, mu, Q, KIc):
+    ep = E / (1 - nu * nu)
+    return math.sqrt(32 / math.pi) * KIc / (ep ** 3 * 12 * mu * Q) ** 0.25
+
+
+def read_history(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"kgd_plot: {path} has no rows")
+    need = ["time_s", "crack_length_m", "mouth_opening_m", "inlet_pressure_pa"]
+    for key in need:
+        if key not in rows[0]:
+            sys.exit(f"kgd_plot: {path} has no column '{key}' (columns: {', '.join(rows[0])})")
+    return {k: [float(r[k]) for r in rows] for k in rows[0]}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("run", help="run directory (history.csv, solid.h5, fluid.h5)")
+    for name, default in (("E", 1e7), ("nu", 0.25), ("mu", 0.01), ("Q", 2.5e-4), ("KIc", 100.0), ("sigma0", 1e5),
+                          ("t0", 0.0)):
+        ap.add_argument("--" + name, type=float, default=default)
+    ap.add_argument("--out", help="PNG path (default RUN/kgd.png)")
+    a = ap.parse_args()
+    h = read_history(os.path.join(a.run, "history.csv"))
+    t = h["time_s"]
+    L0 = h["crack_length_m"][0]
+    kmv = km(a.E, a.nu, a.mu, a.Q, a.KIc)
+    vertex = 0 if kmv < 1 else 1 if kmv > 4 else None
+    print(f"Km = {kmv:.3g}: {'M-vertex' if vertex == 0 else 'K-vertex' if vertex == 1 else 'between the vertices'}")
+    print(f"{'t (s)':>8} {'L (m)':>8} {'L ref':>8} {'err':>7} {'w0 (mm)':>8} {'w0 ref':>8} {'err':>7} "
+          f"{'p_net (kPa)':>11} {'ref':>8} {'err':>7}")
+    worst = [0.0, 0.0, 0.0]
+    for i, ti in enumerate(t):
+        te = ti - a.t0
+        if te <= 0 or vertex is None or h["crack_length_m"][i] < 3 * L0:
+            continue
+        ref = vertices(a.E, a.nu, a.mu, a.Q, a.KIc, te)[vertex]
+        sim = (h["crack_length_m"][i], h["mouth_opening_m"][i], h["inlet_pressure_pa"][i] - a.sigma0)
+        err = [(s - r) / r for s, r in zip(sim, ref)]
+        worst = [max(w, abs(e)) for w, e in zip(worst, err)]
+        print(f"{ti:8.3f} {sim[0]:8.4f} {ref[0]:8.4f} {err[0]:+7.3f} {1e3 * sim[1]:8.4f} {1e3 * ref[1]:8.4f} "
+              f"{err[1]:+7.3f} {1e-3 * sim[2]:11.3f} {1e-3 * ref[2]:8.3f} {err[2]:+7.3f}")
+    if vertex is not None:
+        print(f"worst |error| once L >= 3 L0: length {worst[0]:.3f}, opening {worst[1]:.3f}, pressure {worst[2]:.3f}")
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(2, 2, figsize=(11, 8))
+    tt = [x for x in t if x - a.t0 > 0]
+    refs = [vertices(a.E, a.nu, a.mu, a.Q, a.KIc, x - a.t0) for x in tt]
+    ax[0, 0].plot(t, [1e3 * w for w in h["mouth_opening_m"]], "k.", ms=3, label="hfmpm")
+    ax[0, 0].plot(tt, [1e3 * r[0][1] for r in refs], "b-", label="M-vertex")
+    ax[0, 0].plot(tt, [1e3 * r[1][1] for r in refs], "r--", label="K-vertex")
+    ax[0, 0].plot(tt, [1e3 * r[2][1] for r in refs], "g:", label="Geertsma-de Klerk (q = Q/2)")
+    ax[0, 0].set(xlabel="t (s)", ylabel="mouth opening (mm)")
+    ax[0, 1].plot(t, h["crack_length_m"], "k.", ms=3, label="hfmpm")
+    ax[0, 1].plot(tt, [r[0][0] for r in refs], "b-", label="M-vertex")
+    ax[0, 1].plot(tt, [r[1][0] for r in refs], "r--", label="K-vertex")
+    ax[0, 1].plot(tt, [r[2][0] for r in refs], "g:", label="Geertsma-de Klerk")
+    ax[0, 1].set(xlabel="t (s)", ylabel="half-length (m)")
+    ax[1, 0].plot(t, [1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"]], "k.", ms=3, label="hfmpm")
+    ax[1, 0].plot(tt, [1e-3 * r[0][2] for r in refs], "b-", label="M-vertex")
+    ax[1, 0].plot(tt, [1e-3 * r[1][2] for r in refs], "r--", label="K-vertex")
+    ax[1, 0].set(xlabel="t (s)", ylabel="net inlet pressure (kPa)")
+    top = max(1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"])
+    ax[1, 0].set_ylim(min(0, top), max(1.0, 3 * 1e-3 * refs[-1][0][2]))
+    try:
+        import h5py
+        with h5py.File(os.path.join(a.run, "solid.h5"), "r") as f:
+            last = f["frames"][sorted(f["frames"].keys())[-1]]
+            x = last["crack0/positions"][:, 0]
+            ax[1, 1].plot(x, 1e3 * last["crack0/width"][:], "k.-", label="width (mm)")
+            ax2 = ax[1, 1].twinx()
+            ax2.plot(x, 1e-3 * (last["crack0/pressure"][:] - a.sigma0), "c.-", label="net face pressure (kPa)")
+            ax2.set_ylabel("net face pressure (kPa)")
+        ax[1, 1].set(xlabel="x (m)", ylabel="width (mm)", title=f"along the crack at t = {t[-1]:.3g} s")
+    except (OSError, KeyError) as e:
+        ax[1, 1].text(0.1, 0.5, f"no profile: {e}")
+    for axis in ax.flat[:3]:
+        axis.legend(fontsize=8)
+        axis.grid(alpha=0.3)
+    fig.suptitle(f"KGD: E = {a.E:g} Pa, nu = {a.nu:g}, mu = {a.mu:g} Pa s, Q = {a.Q:g} m^2/s (total), "
+                 f"K_Ic = {a.KIc:g}, Km = {kmv:.3g}")
+    fig.tight_layout()
+    out = a.out or os.path.join(a.run, "kgd.png")
+    fig.savefig(out, dpi=110)
+    print(f"kgd_plot: wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
