@@ -233,6 +233,11 @@ void FluidSolver::grid_update(double dt) {
       v_old_[i] = v_new_[i] = 0;
     }
   }
+  // Without an outlet the far end (the crack tip) is a wall: fluid may flow
+  // back from it but not through it. (With a virtual opening the tip node is
+  // not closed for the fluid, and particles ran past the tip, beyond the
+  // grid, where the CPDI weights are clamped.)
+  if (!config_.outlet.enabled) v_new_.back() = std::min(0.0, v_new_.back());
 }
 
 void FluidSolver::g2p(double dt) {
