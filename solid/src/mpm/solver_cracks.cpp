@@ -119,6 +119,13 @@ void Solver::crack_loads() {
 // (crack_loads) uses the current width, so over the steps the faces carry
 // the fluid's pressure at their actual width; only the approach to it is
 // damped where the spring is stiff.
+// A fixed component of node u's field f stays fixed after a velocity change.
+void Solver::keep_fixed(std::size_t u, int f) {
+  const std::uint8_t fixed = (f ? second_ : nodes_).fixed[u];
+  if (fixed & 1) velocity_[f][u].x() = acceleration_[f][u].x() = 0;
+  if (fixed & 2) velocity_[f][u].y() = acceleration_[f][u].y() = 0;
+}
+
 void Solver::implicit_face_stiffness(double dt) {
   const auto& g = config_.grid;
   const NodalFields* fields[2] = {&nodes_, &second_};
@@ -170,11 +177,8 @@ void Solver::implicit_face_stiffness(double dt) {
     velocity_[fb][u] -= impulse / mb * n;
     acceleration_[fa][u] += impulse / (ma * dt) * n;
     acceleration_[fb][u] -= impulse / (mb * dt) * n;
-    for (int f : {fa, fb}) {
-      const std::uint8_t fixed = (f ? second_ : nodes_).fixed[u];
-      if (fixed & 1) velocity_[f][u].x() = acceleration_[f][u].x() = 0;
-      if (fixed & 2) velocity_[f][u].y() = acceleration_[f][u].y() = 0;
-    }
+    keep_fixed(u, fa);
+    keep_fixed(u, fb);
   }
 }
 
@@ -283,12 +287,8 @@ void Solver::contact(double dt) {
       velocity_[1][u] -= dp / m1;
       acceleration_[0][u] += dp / (m0 * dt);
       acceleration_[1][u] -= dp / (m1 * dt);
-      // A fixed component stays fixed.
-      for (int f = 0; f < 2; ++f) {
-        const std::uint8_t fixed = (f ? second_ : nodes_).fixed[u];
-        if (fixed & 1) velocity_[f][u].x() = acceleration_[f][u].x() = 0;
-        if (fixed & 2) velocity_[f][u].y() = acceleration_[f][u].y() = 0;
-      }
+      keep_fixed(u, 0);
+      keep_fixed(u, 1);
     } else {
       nodes_.momentum[u] += dp;
       second_.momentum[u] -= dp;

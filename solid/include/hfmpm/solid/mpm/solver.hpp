@@ -108,6 +108,7 @@ class Solver {
   bool near_crack(const Vec2& x) const;
   void crack_loads();
   void implicit_face_stiffness(double dt);
+  void keep_fixed(std::size_t u, int f);
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
