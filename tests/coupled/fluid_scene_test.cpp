@@ -206,6 +206,8 @@ TEST(FluidScene, BadFluidSettingsAreRefused) {
       {"fluid.mpm.crack_ids=[3]", "fluid.mpm.crack_ids[0]", "below 1"},
       {"fluid.mpm.initial_fill.front_m=5", "fluid.mpm.initial_fill.front_m", "initial length"},
       {"fluid.mpm.inlet.pressure_pa.constant=-1", "fluid.mpm.inlet.pressure_pa.constant", ">= 0"},
+      {"fluid.mpm.virtual_opening_m=-1e-5", "fluid.mpm.virtual_opening_m", ">= 0"},
+      {"fluid.mpm.lag=LAG_UNSPECIFIED", "fluid.mpm.lag", "ZERO_PRESSURE or FRONT_PRESSURE"},
   };
   for (const auto& c : cases) {
     const auto result = run({bin("hfmpm"), "validate", source("scenarios/channel.scene"), "--set", c.set}, 30);
