@@ -32,9 +32,7 @@ class Crack {
   // 0: none given) and the widths it was computed from (m).
   std::vector<double>& pressure() { return pressure_; }
   const std::vector<double>& pressure() const { return pressure_; }
-  std::vector<double>& pressure_stiffness() { return stiffness_; }
   const std::vector<double>& pressure_stiffness() const { return stiffness_; }
-  std::vector<double>& reference_width() { return reference_width_; }
   // Take a new fluid pressure; see Solver::set_crack_pressure.
   void receive_pressure(const std::vector<double>& pressure, const std::vector<double>& stiffness,
                         const std::vector<double>& width);
