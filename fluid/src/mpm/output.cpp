@@ -64,7 +64,7 @@ void FluidSolver::project_pressure() {
     nodal_pressure_[i] = wetted ? std::max(0.0, nodal_pressure_[i] / mass_[i]) : 0.0;  // lag zone beyond the front
   }
   if (config_.lag == FluidConfig::Lag::Front) {
-    const double p_front = particles_.pressure[particles_.size() - 1];
+    const double p_front = std::min(particles_.pressure[particles_.size() - 1], mouth_pressure());
     for (std::size_t i = 0; i < n; ++i) {
       if (grid_.arc()[i] > front) nodal_pressure_[i] = p_front;
     }
