@@ -105,11 +105,16 @@ def main():
     ax[0, 0].plot(tt, [1e3 * r[1][1] for r in refs], "r--", label="K-vertex")
     ax[0, 0].plot(tt, [1e3 * r[2][1] for r in refs], "g:", label="Geertsma-de Klerk (q = Q/2)")
     ax[0, 0].set(xlabel="t (s)", ylabel="mouth opening (mm)")
+    shown_w = [1e3 * r[vertex if vertex is not None else 0][1] for r in refs] + [1e3 * r[2][1] for r in refs]
+    ax[0, 0].set_ylim(0, 1.3 * max([1e3 * w for w in h["mouth_opening_m"]] + shown_w))
     ax[0, 1].plot(t, h["crack_length_m"], "k.", ms=3, label="hfmpm")
     ax[0, 1].plot(tt, [r[0][0] for r in refs], "b-", label="M-vertex")
     ax[0, 1].plot(tt, [r[1][0] for r in refs], "r--", label="K-vertex")
     ax[0, 1].plot(tt, [r[2][0] for r in refs], "g:", label="Geertsma-de Klerk")
     ax[0, 1].set(xlabel="t (s)", ylabel="half-length (m)")
+    # Scale to the run and the selected vertex (the other can be far off).
+    shown = [r[vertex if vertex is not None else 0][0] for r in refs] + [r[2][0] for r in refs]
+    ax[0, 1].set_ylim(0, 1.3 * max(h["crack_length_m"] + shown))
     ax[1, 0].plot(t, [1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"]], "k.", ms=3, label="hfmpm")
     ax[1, 0].plot(tt, [1e-3 * r[0][2] for r in refs], "b-", label="M-vertex")
     ax[1, 0].plot(tt, [1e-3 * r[1][2] for r in refs], "r--", label="K-vertex")

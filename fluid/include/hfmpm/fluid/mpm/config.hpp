@@ -60,8 +60,9 @@ struct FluidConfig {
   // stays in the fluid.
   double virtual_opening = 0;
   // Pressure on the crack between the fluid front and the tip (the lag):
-  // Zero (vapour pressure, DESIGN.md 3), or Front: the pressure of the
-  // fluid at the front, at most the mouth's (the fluid flows towards the
+  // Zero (vapour pressure, DESIGN.md 3), or Front: the first crack node
+  // beyond the front carries the pressure of the fluid at the front, at most
+  // the mouth's (the fluid flows towards the
   // tip; the last particle, compressed against the closed tip, can carry
   // far more) (the zero-lag closure of the KGD solutions, valid for
   // t >> 12 mu E'^2 / sigma0^3). With growth in steps of half a cell, a dry
