@@ -71,6 +71,9 @@ def main():
                           ("t0", 0.0)):
         ap.add_argument("--" + name, type=float, default=default)
     ap.add_argument("--out", help="PNG path (default RUN/kgd.png)")
+    ap.add_argument("--reference", choices=("vertex", "gdk"), default="vertex",
+                    help="print errors against the vertex Km selects (default) or Geertsma-de Klerk "
+                         "(length and opening; no pressure)")
     a = ap.parse_args()
     h = read_history(os.path.join(a.run, "history.csv"))
     t = h["time_s"]
@@ -78,20 +81,27 @@ def main():
     kmv = km(a.E, a.nu, a.mu, a.Q, a.KIc)
     vertex = 0 if kmv < 1 else 1 if kmv > 4 else None
     print(f"Km = {kmv:.3g}: {'M-vertex' if vertex == 0 else 'K-vertex' if vertex == 1 else 'between the vertices'}")
+    compare = vertex
+    if a.reference == "gdk":
+        compare = 2
+        print("errors against Geertsma-de Klerk (q = Q/2 into the wing; no pressure reference)")
     print(f"{'t (s)':>8} {'L (m)':>8} {'L ref':>8} {'err':>7} {'w0 (mm)':>8} {'w0 ref':>8} {'err':>7} "
           f"{'p_net (kPa)':>11} {'ref':>8} {'err':>7}")
     worst = [0.0, 0.0, 0.0]
     for i, ti in enumerate(t):
         te = ti - a.t0
-        if te <= 0 or vertex is None or h["crack_length_m"][i] < 3 * L0:
+        if te <= 0 or compare is None or h["crack_length_m"][i] < 3 * L0:
             continue
-        ref = vertices(a.E, a.nu, a.mu, a.Q, a.KIc, te)[vertex]
+        ref = vertices(a.E, a.nu, a.mu, a.Q, a.KIc, te)[compare]
+        if compare == 2:  # Geertsma-de Klerk: (length, opening); no pressure
+            ref = (ref[0], ref[1], float("nan"))
         sim = (h["crack_length_m"][i], h["mouth_opening_m"][i], h["inlet_pressure_pa"][i] - a.sigma0)
         err = [(s - r) / r for s, r in zip(sim, ref)]
+        err = [0.0 if math.isnan(e) else e for e in err]
         worst = [max(w, abs(e)) for w, e in zip(worst, err)]
         print(f"{ti:8.3f} {sim[0]:8.4f} {ref[0]:8.4f} {err[0]:+7.3f} {1e3 * sim[1]:8.4f} {1e3 * ref[1]:8.4f} "
               f"{err[1]:+7.3f} {1e-3 * sim[2]:11.3f} {1e-3 * ref[2]:8.3f} {err[2]:+7.3f}")
-    if vertex is not None:
+    if compare is not None:
         print(f"worst |error| once L >= 3 L0: length {worst[0]:.3f}, opening {worst[1]:.3f}, pressure {worst[2]:.3f}")
 
     import matplotlib

@@ -1,4 +1,6 @@
-// The real solid and the real fluid coupled: scenarios/kgd-toughness.scene,
+// The real solid and the real fluid coupled.
+//
+// scenarios/kgd-toughness.scene,
 // shortened to 0.6 s, through `hfmpm run`. Not yet an accuracy test against
 // the K-vertex (issue 5 is open: docs/verification.md, "Coupled KGD"); it
 // holds what the coupled run must already get right:
@@ -53,6 +55,91 @@ TEST(KgdScene, ToughnessSceneRunsStablyConservesFluidAndGrows) {
   EXPECT_GT(mouth.back(), 5e-4);
   EXPECT_GE(length.back(), 0.2 + 0.02);  // at least one growth step of half a cell (0.025 m)
   for (std::size_t i = 1; i < t.size(); ++i) EXPECT_GE(length[i], length[i - 1] - 1e-3) << "t = " << t[i];
+}
+
+// The M-vertex (zero toughness, zero lag; Spence and Sharp 1985, Adachi and
+// Detournay 2002) for the total rate Q: half-length, mouth opening and net
+// inlet pressure at time t.
+struct Vertex {
+  double length, opening, pressure;
+};
+Vertex m_vertex(double E, double nu, double mu, double Q, double t) {
+  const double ep = E / (1 - nu * nu), mup = 12 * mu;
+  return {0.6152 * std::pow(ep * Q * Q * Q * t * t * t * t / mup, 1.0 / 6),
+          1.126 * std::pow(mup * Q * Q * Q * t * t / ep, 1.0 / 6), 0.545 * std::cbrt(mup * ep * ep / t)};
+}
+
+TEST(KgdScene, MVertexReference) {
+  // The numbers the issue quotes for the full-size scene at 10 s.
+  const Vertex v = m_vertex(1e7, 0.25, 0.01, 2.5e-4, 10);
+  EXPECT_NEAR(v.length, 0.954, 1e-3);
+  EXPECT_NEAR(v.opening, 1.82e-3, 1e-5);
+  EXPECT_NEAR(v.pressure, 6.05e3, 10);
+}
+
+// scenarios/kgd-viscosity-ci.scene as it stands (5 s, h = 0.05 m). Once the
+// crack is three notch lengths long (0.45 m, t >= ~3.2 s), half-length and
+// mouth opening are within the issue's CI-size 10% of the M-vertex (time
+// shifted by half the 0.05 s ramp). Measured: 5.8% and 5.4% worst. The net
+// inlet pressure is printed, not asserted: it is 32-111% high (issue 5 open;
+// docs/verification.md, "Coupled KGD"). Also asserted: the injected volume
+// is the integral of the ramp; the fluid's volume is its zero-pressure
+// volume less a compression of at most the Tait J at the run's highest inlet
+// pressure; the run stays quasi-static.
+TEST(KgdScene, ViscosityCiSceneFollowsTheMVertexInLengthAndOpening) {
+  const auto out = scratch_dir("kgd_viscosity_ci");
+  const auto result = run_scene(read_file(source("scenarios/kgd-viscosity-ci.scene")), out,
+                                {"--set", "output.hdf5=false"}, 900);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const Csv h = read_csv(out + "/history.csv");
+  const auto t = h.values("time_s"), length = h.values("crack_length_m"), mouth = h.values("mouth_opening_m");
+  const auto p_in = h.values("inlet_pressure_pa"), injected = h.values("injected_volume_m2");
+  const auto volume = h.values("fluid_volume_m2"), ke = h.values("kinetic_energy_j");
+  ASSERT_GE(t.size(), 20u);
+  ASSERT_NEAR(t.back(), 5, 1e-3);
+  constexpr double kQ = 2.5e-4, kRamp = 0.05, kSigma0 = 1e5, kNotch = 0.15;
+  constexpr double kInitial = kNotch * 2e-5;  // the notch's fluid: the virtual film x 0.15 m
+  const auto dt = h.values("dt_s");
+  const double dt_max = *std::max_element(dt.begin(), dt.end());
+  const double p_max = *std::max_element(p_in.begin(), p_in.end());
+  const double j_min = 1 - 0.0894 * std::log1p(p_max / (0.0894 * 2e6));  // Tait, c = 0.0894
+  double work = 0, worst_length = 0, worst_opening = 0, worst_pressure = 0;
+  int compared = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    for (double v : {length[i], mouth[i], p_in[i], injected[i], volume[i], ke[i]}) ASSERT_TRUE(std::isfinite(v));
+    const double q = 0.5 * kQ;  // into the modelled wing
+    const double exact = t[i] >= kRamp ? q * (t[i] - 0.5 * kRamp) : 0.5 * q * t[i] * t[i] / kRamp;
+    // The inlet integrates Q(t) by the trapezoid rule per fluid substep: exact
+    // but for the substep holding the ramp's kink, which errs by at most
+    // (q / t_ramp) dt^2 / 8 (dt <= the coupled step; measured 2.3e-13 m^2).
+    EXPECT_NEAR(injected[i], exact, q / kRamp * dt_max * dt_max / 8 + 1e-9 * q) << "t = " << t[i];
+    if (i > 0) work += 0.5 * (p_in[i] + p_in[i - 1]) * (injected[i] - injected[i - 1]);
+    if (t[i] > 0.1) {
+      EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
+      // Compressed by the Tait law (K = 2 MPa) at most to J at the highest
+      // inlet pressure of the run (measured 0.944 at 1.55e5 Pa, against a
+      // ratio of 0.954-0.959), and never beyond its zero-pressure volume.
+      const double ratio = volume[i] / (injected[i] + kInitial);
+      EXPECT_GT(ratio, j_min) << "t = " << t[i];
+      EXPECT_LT(ratio, 1.0 + 1e-9) << "t = " << t[i];
+    }
+    if (length[i] < 3 * kNotch) continue;
+    const Vertex v = m_vertex(1e7, 0.25, 0.01, kQ, t[i] - 0.5 * kRamp);
+    const double e_length = length[i] / v.length - 1, e_opening = mouth[i] / v.opening - 1;
+    const double e_pressure = (p_in[i] - kSigma0) / v.pressure - 1;
+    std::printf("t %.2f s: half-length %+.3f, mouth opening %+.3f, net inlet pressure %+.3f\n", t[i], e_length,
+                e_opening, e_pressure);
+    EXPECT_LT(std::abs(e_length), 0.10) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_opening), 0.10) << "t = " << t[i];
+    worst_length = std::max(worst_length, std::abs(e_length));
+    worst_opening = std::max(worst_opening, std::abs(e_opening));
+    worst_pressure = std::max(worst_pressure, std::abs(e_pressure));
+    ++compared;
+  }
+  std::printf("kgd-viscosity-ci: %d rows compared; worst half-length %.3f, mouth opening %.3f, net inlet pressure "
+              "%.3f (not asserted)\n",
+              compared, worst_length, worst_opening, worst_pressure);
+  EXPECT_GE(compared, 5);  // the crack reached three notch lengths by ~3.2 s
 }
 
 }  // namespace

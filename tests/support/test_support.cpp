@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -13,7 +14,35 @@
 #include <stdexcept>
 #include <thread>
 
+#include <gtest/gtest.h>
+
 namespace hfmpm::test {
+namespace {
+
+// Scratch directories are removed when the test program ends with every test
+// passed (kept after a failure, or with HFMPM_KEEP_TEST_OUTPUT set, for a look).
+class ScratchDirs {
+ public:
+  void add(const std::string& path) { paths_.push_back(path); }
+  ~ScratchDirs() {
+    if (std::getenv("HFMPM_KEEP_TEST_OUTPUT") != nullptr) return;
+    if (!::testing::UnitTest::GetInstance()->Passed()) return;
+    for (const auto& p : paths_) {
+      std::error_code ec;
+      std::filesystem::remove_all(p, ec);
+    }
+  }
+
+ private:
+  std::vector<std::string> paths_;
+};
+
+ScratchDirs& scratch_dirs() {
+  static ScratchDirs dirs;
+  return dirs;
+}
+
+}  // namespace
 
 std::string bin(const std::string& program) { return std::string(HFMPM_BIN_DIR) + "/" + program; }
 std::string source(const std::string& relative) { return std::string(HFMPM_SOURCE_DIR) + "/" + relative; }
@@ -21,6 +50,7 @@ std::string source(const std::string& relative) { return std::string(HFMPM_SOURC
 std::string scratch_dir(const std::string& name) {
   std::string pattern = "/tmp/hfmpm-test-" + name + "-XXXXXX";
   if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+  scratch_dirs().add(pattern);
   return pattern;
 }
 
