@@ -43,10 +43,13 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   c.non_negative(key + "viscosity_pa_s", f.viscosity_pa_s(), "Pa s");
   c.range(key + "cfl", f.cfl(), 0, 1, true, "dimensionless");
   c.non_negative(key + "particle_length_m", f.particle_length_m(), "m; 0 = half the mouth element");
+  if (!(f.merge_fraction() >= 0 && f.merge_fraction() < 2))
+    c.bad(key + "merge_fraction", text(f.merge_fraction()), "a finite value >= 0 and < 2 (of particle_length)");
   c.range(key + "flip_fraction", f.flip_fraction(), 0, 1, false, "0 = PIC, 1 = FLIP");
   c.positive(key + "min_width_m", f.min_width_m(), "m");
   c.non_negative(key + "virtual_opening_m", f.virtual_opening_m(), "m");
-  if (f.lag() == scene::MpmFluid::LAG_UNSPECIFIED) c.bad(key + "lag", "LAG_UNSPECIFIED", "ZERO_PRESSURE or FRONT_PRESSURE");
+  if (f.lag() == scene::MpmFluid::LAG_UNSPECIFIED) c.bad(key + "lag", "LAG_UNSPECIFIED", "ZERO_PRESSURE, FRONT_PRESSURE or FIXED_PRESSURE");
+  c.non_negative(key + "lag_pressure_pa", f.lag_pressure_pa(), "Pa");
   if (f.max_substeps() < 1 || f.max_substeps() > 100000) {
     c.bad(key + "max_substeps", std::to_string(f.max_substeps()), "1 to 100000 fluid steps per coupled step");
   }

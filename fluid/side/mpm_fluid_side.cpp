@@ -169,6 +169,7 @@ mpm::FluidConfig to_fluid_config(const scene::MpmFluid& f) {
   c.viscosity = f.viscosity_pa_s();
   c.cfl = f.cfl();
   c.particle_length = f.particle_length_m();
+  c.merge_fraction = f.merge_fraction();
   c.flip = f.flip_fraction();
   c.smooth_jacobian = f.element_pressure();
   c.min_width = f.min_width_m();
@@ -183,7 +184,10 @@ mpm::FluidConfig to_fluid_config(const scene::MpmFluid& f) {
   c.inlet.pre_opening = in.pre_opening_m();
   c.inlet.pre_opening_length = in.pre_opening_length_m();
   c.virtual_opening = f.virtual_opening_m();
-  c.lag = f.lag() == scene::MpmFluid::FRONT_PRESSURE ? mpm::FluidConfig::Lag::Front : mpm::FluidConfig::Lag::Zero;
+  c.lag = f.lag() == scene::MpmFluid::FRONT_PRESSURE   ? mpm::FluidConfig::Lag::Front
+          : f.lag() == scene::MpmFluid::FIXED_PRESSURE ? mpm::FluidConfig::Lag::Fixed
+                                                       : mpm::FluidConfig::Lag::Zero;
+  c.lag_pressure = f.lag_pressure_pa();
   if (f.has_outlet()) {
     c.outlet.enabled = true;
     c.outlet.pressure = proto::to_time_function(f.outlet().pressure_pa());

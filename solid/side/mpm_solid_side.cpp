@@ -77,6 +77,7 @@ class MpmSolidSide final : public coupling::SideModel {
                                    ": its ids must be the crack's ids in order (a prefix while the crack grows)");
       }
       solver_->set_crack_pressure(c.crack_id(), pressure.pressure, pressure.stiffness, pressure.width);
+      solver_->set_crack_front(c.crack_id(), pressure.front_position);
     }
   }
   SideDiagnostics diagnostics() const override {
@@ -243,6 +244,7 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   c.fracture.growth_cells = s.fracture().growth_cells();
   c.fracture.check_interval = static_cast<int>(s.fracture().check_interval());
   c.fracture.straight = s.fracture().direction() == scene::FractureSpec::STRAIGHT;
+  if (s.fracture().has_max_lag_cells()) c.fracture.max_lag_cells = s.fracture().max_lag_cells();
   c.implicit_face_stiffness = s.implicit_face_stiffness();
   c.threads = static_cast<int>(s.threads());
   for (const auto& cr : s.cracks()) {

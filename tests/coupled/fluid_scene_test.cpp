@@ -207,7 +207,9 @@ TEST(FluidScene, BadFluidSettingsAreRefused) {
       {"fluid.mpm.initial_fill.front_m=5", "fluid.mpm.initial_fill.front_m", "initial length"},
       {"fluid.mpm.inlet.pressure_pa.constant=-1", "fluid.mpm.inlet.pressure_pa.constant", ">= 0"},
       {"fluid.mpm.virtual_opening_m=-1e-5", "fluid.mpm.virtual_opening_m", ">= 0"},
-      {"fluid.mpm.lag=LAG_UNSPECIFIED", "fluid.mpm.lag", "ZERO_PRESSURE or FRONT_PRESSURE"},
+      {"fluid.mpm.lag=LAG_UNSPECIFIED", "fluid.mpm.lag", "ZERO_PRESSURE, FRONT_PRESSURE or FIXED_PRESSURE"},
+      {"fluid.mpm.lag_pressure_pa=-1", "fluid.mpm.lag_pressure_pa", ">= 0"},
+      {"fluid.mpm.merge_fraction=2", "fluid.mpm.merge_fraction", ">= 0 and < 2"},
   };
   for (const auto& c : cases) {
     const auto result = run({bin("hfmpm"), "validate", source("scenarios/channel.scene"), "--set", c.set}, 30);

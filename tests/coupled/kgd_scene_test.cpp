@@ -1,11 +1,12 @@
 // The real solid and the real fluid coupled.
 //
-// scenarios/kgd-toughness.scene,
-// shortened to 0.6 s, through `hfmpm run`. Not yet an accuracy test against
-// the K-vertex (issue 5 is open: docs/verification.md, "Coupled KGD"); it
-// holds what the coupled run must already get right:
+// scenarios/kgd-toughness.scene, shortened to 0.6 s, through `hfmpm run`:
+// the start of the run, before the crack is three notch lengths long (the
+// K-vertex comparison of the full run is in docs/verification.md, "Coupled
+// KGD"). It holds what the coupled run must get right from the start:
 // - the fluid's mass: the injected volume equals the integral of the inlet
-//   ramp Q(t) (exact: 4.15e-4 (t - 0.025) once the 0.05 s ramp is over);
+//   ramp Q(t) (4.15e-4 (t - 0.025) once the 0.05 s ramp is over; exact to the
+//   trapezoid error of the substep holding the ramp's kink);
 // - the fluid's volume (sum of l w) within 10% of its zero-pressure volume
 //   (injected plus initial): the compression at the pressures reached is
 //   under 6%, and partly filled particles (J > 1, at zero pressure) count
@@ -35,12 +36,16 @@ TEST(KgdScene, ToughnessSceneRunsStablyConservesFluidAndGrows) {
   const auto volume = h.values("fluid_volume_m2"), ke = h.values("kinetic_energy_j");
   ASSERT_GE(t.size(), 10u);
   constexpr double kQ = 4.15e-4, kRamp = 0.05, kSigma0 = 1e5, kK = 2e6, kC = 0.0894;
+  const auto dt = h.values("dt_s");
+  const double dt_max = *std::max_element(dt.begin(), dt.end());
   constexpr double kInitial = 0.2 * 2e-5;     // the notch's fluid at 1e5 Pa: the virtual film x 0.2 m
   double work = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     for (double v : {length[i], mouth[i], p_in[i], injected[i], volume[i], ke[i]}) ASSERT_TRUE(std::isfinite(v));
     const double exact = t[i] >= kRamp ? kQ * (t[i] - 0.5 * kRamp) : 0.5 * kQ * t[i] * t[i] / kRamp;
-    EXPECT_NEAR(injected[i], exact, 1e-9 * kQ) << "t = " << t[i];
+    // Trapezoid per fluid substep: exact but for the substep holding the
+    // ramp's kink, at most (Q / t_ramp) dt^2 / 8 off.
+    EXPECT_NEAR(injected[i], exact, kQ / kRamp * dt_max * dt_max / 8 + 1e-9 * kQ) << "t = " << t[i];
     if (i > 0) work += 0.5 * (p_in[i] + p_in[i - 1]) * (injected[i] - injected[i - 1]);
     if (t[i] > 0.1) {
       EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
@@ -77,16 +82,17 @@ TEST(KgdScene, MVertexReference) {
   EXPECT_NEAR(v.pressure, 6.05e3, 10);
 }
 
-// scenarios/kgd-viscosity-ci.scene as it stands (5 s, h = 0.05 m). Once the
+// scenarios/kgd-viscosity-ci.scene as it stands (5 s, h = 0.035 m). Once the
 // crack is three notch lengths long (0.45 m, t >= ~3.2 s), half-length and
-// mouth opening are within the issue's CI-size 10% of the M-vertex (time
-// shifted by half the 0.05 s ramp). Measured: 5.8% and 5.4% worst. The net
-// inlet pressure is printed, not asserted: it is 32-111% high (issue 5 open;
-// docs/verification.md, "Coupled KGD"). Also asserted: the injected volume
-// is the integral of the ramp; the fluid's volume is its zero-pressure
-// volume less a compression of at most the Tait J at the run's highest inlet
-// pressure; the run stays quasi-static.
-TEST(KgdScene, ViscosityCiSceneFollowsTheMVertexInLengthAndOpening) {
+// mouth opening are within the issue's CI-size 10% of the M-vertex and the
+// net inlet pressure within 20% (time shifted by half the 0.05 s ramp).
+// Measured: 7.4%, 5.4% and 3.4% worst (at h = 0.05 m the first row's length
+// is 11.6% long, which is why the CI scene uses 0.035 m; docs/verification.md,
+// "Coupled KGD"). Also asserted: the injected volume is the integral of the
+// ramp; the fluid's volume is its zero-pressure volume less a compression of
+// at most the Tait J at the run's highest inlet pressure; the run stays
+// quasi-static.
+TEST(KgdScene, ViscosityCiSceneFollowsTheMVertex) {
   const auto out = scratch_dir("kgd_viscosity_ci");
   const auto result = run_scene(read_file(source("scenarios/kgd-viscosity-ci.scene")), out,
                                 {"--set", "output.hdf5=false"}, 900);
@@ -131,13 +137,14 @@ TEST(KgdScene, ViscosityCiSceneFollowsTheMVertexInLengthAndOpening) {
                 e_opening, e_pressure);
     EXPECT_LT(std::abs(e_length), 0.10) << "t = " << t[i];
     EXPECT_LT(std::abs(e_opening), 0.10) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_pressure), 0.20) << "t = " << t[i];
     worst_length = std::max(worst_length, std::abs(e_length));
     worst_opening = std::max(worst_opening, std::abs(e_opening));
     worst_pressure = std::max(worst_pressure, std::abs(e_pressure));
     ++compared;
   }
   std::printf("kgd-viscosity-ci: %d rows compared; worst half-length %.3f, mouth opening %.3f, net inlet pressure "
-              "%.3f (not asserted)\n",
+              "%.3f\n",
               compared, worst_length, worst_opening, worst_pressure);
   EXPECT_GE(compared, 5);  // the crack reached three notch lengths by ~3.2 s
 }

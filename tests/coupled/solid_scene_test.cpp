@@ -46,6 +46,7 @@ TEST(SolidScene, BadFractureSettingsAreRefused) {
       {"solid.mpm.fracture.growth_cells=1.5", "solid.mpm.fracture.growth_cells", "cells"},
       {"solid.mpm.fracture.check_interval=0", "solid.mpm.fracture.check_interval", "at least 1 step"},
       {"solid.mpm.fracture.direction=DIRECTION_UNSPECIFIED", "solid.mpm.fracture.direction", "MAX_HOOP_STRESS or STRAIGHT"},
+      {"solid.mpm.fracture.max_lag_cells=-0.5", "solid.mpm.fracture.max_lag_cells", ">= 0"},
       {"solid.mpm.damping.feedback_q_m2=-1", "solid.mpm.damping.feedback_q_m2", "m^2"},
       {"solid.mpm.materials=[{name: \"rock\" youngs_modulus_pa: 1e10 poisson_ratio: 0.25 density_kg_m3: 2500 "
        "toughness_j_m2: 1 toughness_pa_sqrt_m: 1e5}]",

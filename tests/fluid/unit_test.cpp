@@ -303,15 +303,17 @@ TEST(FluidSolver, ReportsTheStiffnessOfItsPressureToTheCrackWidth) {
   }
 }
 
-// Beyond the front: zero pressure (vapour), or with Lag::Front the pressure
-// of the fluid at the front (at most the mouth's) on the first node beyond
-// it and zero further on; no stiffness there either way.
+// Beyond the front: zero pressure (vapour); with Lag::Front the pressure of
+// the fluid at the front (at most the mouth's) on the first node beyond it
+// and zero further on; with Lag::Fixed the given lag pressure on every node
+// beyond it. No stiffness there in any case.
 TEST(FluidSolver, LagPressureBeyondTheFront) {
-  for (const auto lag : {FluidConfig::Lag::Zero, FluidConfig::Lag::Front}) {
+  for (const auto lag : {FluidConfig::Lag::Zero, FluidConfig::Lag::Front, FluidConfig::Lag::Fixed}) {
     FluidConfig c;
     c.bulk_modulus = 2e6;
     c.inlet.flow_rate = TimeFunction::constant(0);
     c.lag = lag;
+    c.lag_pressure = 7.5e4;
     FluidSolver fluid(c);
     fluid.set_crack(test::channel(1.0, 20, 1e-3));
     fluid.fill(0.5, 1e5);
@@ -321,7 +323,10 @@ TEST(FluidSolver, LagPressureBeyondTheFront) {
     const double p_front = fluid.particles().pressure.back();
     EXPECT_NEAR(p_front, 1e5, 1.0);
     for (std::size_t i = 11; i < p.size(); ++i) {
-      EXPECT_EQ(p[i], lag == FluidConfig::Lag::Front && i == 11 ? p_front : 0.0) << "node " << i;
+      const double expected = lag == FluidConfig::Lag::Fixed                ? 7.5e4
+                              : lag == FluidConfig::Lag::Front && i == 11 ? p_front
+                                                                          : 0.0;
+      EXPECT_EQ(p[i], expected) << "node " << i;
       EXPECT_EQ(s[i], 0.0);
     }
   }
@@ -351,6 +356,79 @@ TEST(FluidSolver, ClosedFarEndIsAWallEvenWithAVirtualOpening) {
   }
   EXPECT_NEAR(fluid.fluid_mass() / fluid.injected_mass(), 1, 1e-12);
   EXPECT_GT(fluid.inlet_pressure(), 1e5);  // the full crack is being compressed
+}
+
+// merge_fraction: particles squeezed along the crack are merged with a
+// neighbour. A channel with a wall at the far end is filled against the wall
+// (the particles near it are compressed along the crack): with merging on,
+// after every step no particle but the inlet one is shorter than
+// merge_fraction x particle_length, mass stays exactly the injected mass,
+// and the stable step is at least cfl x that length / the sound speed. The
+// same run without merging has shorter particles (the case merging is for).
+TEST(FluidSolver, MergesParticlesSqueezedAlongTheCrack) {
+  double shortest_without = 0;
+  constexpr double kFraction = 0.75;
+  for (const double fraction : {0.0, kFraction}) {
+    FluidConfig c;
+    c.bulk_modulus = 2e6;
+    c.viscosity = 1e-3;
+    c.particle_length = 0.0125;
+    c.merge_fraction = fraction;
+    c.inlet.flow_rate = TimeFunction::constant(2e-4);
+    FluidSolver fluid(c);
+    auto crack = test::channel(0.2, 8, 1e-3);
+    crack.width.back() = 0;  // the tip: a wall
+    fluid.set_crack(crack);
+    double shortest = 1;
+    for (int k = 0; fluid.time() < 1.5; ++k) {  // 0.2 m x 1 mm holds the injection of 1 s
+      fluid.step(0.5 * fluid.stable_dt());
+      const auto& P = fluid.particles();
+      for (std::size_t p = 1; p < P.size(); ++p) {
+        shortest = std::min(shortest, P.length[p]);
+        if (fraction > 0) ASSERT_GE(P.length[p], fraction * c.particle_length * (1 - 1e-12)) << "step " << k;
+        ASSERT_NEAR(P.end(p - 1), P.start(p), 1e-12) << "particles stay contiguous, step " << k;
+      }
+      ASSERT_NEAR(fluid.fluid_mass() / fluid.injected_mass(), 1, 1e-12) << "step " << k;
+    }
+    if (fraction == 0) {
+      shortest_without = shortest;
+    } else {
+      EXPECT_LT(shortest_without, kFraction * c.particle_length) << "the case merging is for did not arise";
+      double speed = std::sqrt(c.bulk_modulus / c.density);
+      for (std::size_t p = 0; p < fluid.particles().size(); ++p)
+        speed = std::max(speed, fluid.eos().sound_speed(fluid.particles().jacobian(p), c.density));
+      const double inlet_length = fluid.particles().length[0];
+      EXPECT_GE(fluid.stable_dt() * (1 + 1e-12),
+                c.cfl * std::min({fraction * c.particle_length, inlet_length, 0.2 / 8}) / speed);
+    }
+  }
+}
+
+// Merging keeps the mass exactly and the fluid's extent (the merged particle
+// spans its parts).
+TEST(FluidSolver, MergingKeepsMassAndExtent) {
+  FluidConfig c;
+  c.bulk_modulus = 2e6;
+  c.particle_length = 0.05;
+  c.merge_fraction = 1.9;  // the 0.05 m particles are short; merged pairs (0.1 m) are not
+  c.inlet.flow_rate = TimeFunction::constant(0);
+  FluidSolver fluid(c);
+  fluid.set_crack(test::channel(1.0, 20, 1e-3));
+  fluid.fill(0.5, 1e5);
+  const double mass = fluid.fluid_mass();
+  ASSERT_GT(fluid.particles().size(), 2u);
+  fluid.step(1e-9);
+  // Ten 0.05 m particles: the inlet particle stays, the nine others merge
+  // into four of at least 0.095 m (pairs, and one triple).
+  ASSERT_EQ(fluid.particles().size(), 5u);
+  double total = 0;
+  for (std::size_t p = 0; p < 5; ++p) {
+    total += fluid.particles().length[p];
+    if (p > 0) EXPECT_GE(fluid.particles().length[p], 1.9 * 0.05) << p;
+  }
+  EXPECT_NEAR(total, 0.5, 1e-6);
+  EXPECT_NEAR(fluid.fluid_mass(), mass, 1e-14 * mass);
+  EXPECT_NEAR(fluid.particles().end(fluid.particles().size() - 1), 0.5, 1e-6);
 }
 
 }  // namespace

@@ -64,6 +64,33 @@ TEST(Propagation, EdgeCrackStartsAtToughnessAndGrowsStraight) {
   EXPECT_GT(crack.plane().back().x(), kA + 2.5 * solid.grid().h);
 }
 
+// fracture.max_lag_cells (the zero-lag closure of fluid-driven cracks): the
+// same edge crack under a load held at 1.5 sigma_c (J well above J_Ic) does
+// not grow while the fluid front reported on it lies more than max_lag_cells
+// cells behind the tip, and grows once the front is within that distance.
+TEST(Propagation, TipWaitsForTheFluidFrontWithMaxLag) {
+  constexpr double kW = 1, kA = 0.3, kH = 1.5 * kW, kToughness = 500;
+  const double e_prime = kRock.plane_strain_modulus();
+  const double sigma_c = std::sqrt(e_prime * kToughness) / (tada_edge_factor(kA / kW) * std::sqrt(kPi * kA));
+  auto config = edge_crack(kW, kA, kH, 20, TimeFunction::constant(1.5 * sigma_c));
+  config.materials[0].toughness = kToughness;
+  config.fracture.propagate = true;
+  config.fracture.check_interval = 5;
+  config.fracture.max_lag_cells = 0.5;
+  Solver solid(config);
+  const double h = solid.grid().h, dt = solid.stable_dt();
+  const std::size_t initial = solid.cracks()[0].size();
+  solid.set_crack_front(0, kA - 0.6 * h);  // 0.6 cells of dry crack: too far
+  const double transit = 2 * kH / kRock.p_wave_speed(kRock.density);
+  while (solid.time() < 3 * transit) solid.step(dt);
+  ASSERT_FALSE(solid.last_tips().empty());
+  EXPECT_GT(solid.last_tips().at(0).j, 1.5 * kToughness) << "the load must drive growth";
+  EXPECT_EQ(solid.cracks()[0].size(), initial) << "grew with the fluid front 0.6 cells behind the tip";
+  solid.set_crack_front(0, kA - 0.4 * h);  // within half a cell: may grow
+  for (int k = 0; k < 10 && solid.cracks()[0].size() == initial; ++k) solid.step(dt);
+  EXPECT_EQ(solid.cracks()[0].size(), initial + 1);
+}
+
 // A pressurised edge crack in the stiffer of two bonded layers, parallel to
 // the interface and a few cells below it, turns towards the softer layer
 // (cracks are drawn to compliant material: the mismatch gives K_II of the

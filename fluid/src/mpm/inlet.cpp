@@ -128,6 +128,25 @@ void FluidSolver::merge(std::size_t p) {
   reset_reference(p);
 }
 
+void FluidSolver::merge_short() {
+  auto& P = particles_;
+  const double shortest = config_.merge_fraction * particle_length_;
+  if (!(shortest > 0)) return;
+  // The inlet particle (0) is left alone: the inlet keeps it between half and
+  // twice particle_length. Any other short particle joins the shorter of its
+  // neighbours (the last one joins the one before it).
+  std::size_t p = 1;
+  while (p < P.size() && P.size() > 1) {
+    if (P.length[p] >= shortest) {
+      ++p;
+      continue;
+    }
+    const bool before = p + 1 == P.size() || P.length[p - 1] <= P.length[p + 1];
+    merge(before ? p - 1 : p);
+    if (before) p = std::max<std::size_t>(1, p - 1);
+  }
+}
+
 void FluidSolver::outlet(double dt) {
   auto& P = particles_;
   if (!config_.outlet.enabled || P.size() == 0) return;

@@ -63,6 +63,10 @@ void FluidSolver::project_pressure() {
     const bool wetted = grid_.arc()[i] <= front && mass_[i] > 0;
     nodal_pressure_[i] = wetted ? std::max(0.0, nodal_pressure_[i] / mass_[i]) : 0.0;  // lag zone beyond the front
   }
+  if (config_.lag == FluidConfig::Lag::Fixed) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (grid_.arc()[i] > front) nodal_pressure_[i] = config_.lag_pressure;
+  }
   if (config_.lag == FluidConfig::Lag::Front) {
     const double p_front = std::min(particles_.pressure[particles_.size() - 1], mouth_pressure());
     // Only up to the first node beyond the front: the crack the fluid is

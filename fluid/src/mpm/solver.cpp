@@ -23,6 +23,8 @@ FluidSolver::FluidSolver(FluidConfig config) : config_(std::move(config)) {
   require(c.bulk_modulus > 0 && std::isfinite(c.bulk_modulus), "bulk_modulus", c.bulk_modulus, "> 0 Pa");
   require(c.tait_c > 0 && std::isfinite(c.tait_c), "tait_c", c.tait_c, "> 0 (0.0894 for water)");
   require(c.cfl > 0 && c.cfl <= 1, "cfl", c.cfl, "(0, 1]");
+  require(c.lag_pressure >= 0 && std::isfinite(c.lag_pressure), "lag_pressure", c.lag_pressure, ">= 0 Pa");
+  require(c.merge_fraction >= 0 && c.merge_fraction < 2, "merge_fraction", c.merge_fraction, ">= 0 and < 2");
   require(c.particle_length >= 0 && std::isfinite(c.particle_length), "particle_length", c.particle_length,
           ">= 0 m (0: half the mouth element)");
   require(c.flip >= 0 && c.flip <= 1, "flip", c.flip, "[0, 1]");
@@ -148,6 +150,7 @@ void FluidSolver::step(double dt) {
   }
   inlet(dt);
   outlet(dt);
+  merge_short();
   t_ += dt;
   ++steps_;
   update_state();

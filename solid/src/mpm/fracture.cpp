@@ -312,6 +312,10 @@ int Solver::propagate() {
   for (const auto& tip : last_tips_) {
     const bool straight = config_.fracture.straight;
     if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
+    if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
+      const double dry = arc_length(cracks_[tip.crack].plane()).back() - cracks_[tip.crack].wetted_length();
+      if (dry > config_.fracture.max_lag_cells * h) continue;  // wait for the fluid (zero-lag closure)
+    }
     const double kink = straight ? 0.0 : tip.kink;
     const double c = std::cos(kink), s = std::sin(kink);
     const Vec2 d(c * tip.direction.x() - s * tip.direction.y(), s * tip.direction.x() + c * tip.direction.y());

@@ -86,6 +86,8 @@ void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressu
   cracks_.at(c).receive_pressure(pressure, stiffness, width);
 }
 
+void Solver::set_crack_front(std::size_t c, double arc_length) { cracks_.at(c).set_wetted_length(arc_length); }
+
 void Solver::crack_loads() {
   const auto& g = config_.grid;
   const NodalFields* fields[2] = {&nodes_, &second_};

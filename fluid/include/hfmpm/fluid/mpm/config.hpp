@@ -46,6 +46,11 @@ struct FluidConfig {
   // split when it reaches twice this). 0: half the mouth element, fixed at
   // the first set_crack().
   double particle_length = 0;
+  // -, a particle (not the inlet particle) shorter than merge_fraction x
+  // particle_length after a step is merged with its shorter neighbour (mass
+  // and momentum kept): particles squeezed along the crack near a closed tip
+  // otherwise set the fluid's stable step. 0: never; < 2 (the split length).
+  double merge_fraction = 0;
   double flip = 0;  // -, FLIP fraction of the particle velocity update (0 = PIC)
   // Pressure constant per element, from the volume ratio of the fluid in it
   // (against volumetric locking, see FluidSolver::element_pressure); false:
@@ -69,8 +74,13 @@ struct FluidConfig {
   // segment at zero pressure is shut by the confining stress until the net
   // pressure is several times the zero-lag one (the step is much longer than
   // the physical lag); Front lets the fluid's pressure reach the tip.
-  enum class Lag { Zero, Front };
+  // Fixed: every node beyond the front carries lag_pressure (a cavity at a
+  // pore pressure; or the confining stress as a zero-lag closure, so the dry
+  // zone the grid cannot make small carries no net load; pair it with the
+  // solid's fracture.max_lag_cells, or a crack with little toughness runs dry).
+  enum class Lag { Zero, Front, Fixed };
   Lag lag = Lag::Zero;
+  double lag_pressure = 0;  // Pa, for Lag::Fixed
   double min_width = 1e-9;  // m, width floor in the drag and in w0 (numerical; the drag is implicit)
   InletConfig inlet;
   OutletConfig outlet;

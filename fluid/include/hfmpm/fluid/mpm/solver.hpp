@@ -141,6 +141,7 @@ class FluidSolver {
   void outlet(double dt);
   void split_inlet();
   void merge(std::size_t p);  // merge particle p + 1 into p
+  void merge_short();         // see FluidConfig::merge_fraction
   // output.cpp
   void project_pressure();
 

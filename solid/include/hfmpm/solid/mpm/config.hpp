@@ -75,6 +75,10 @@ struct Fracture {
   // on, driven by the mode-I part of J only; K_II there is discretization
   // noise (the side tests put a crack lying on a grid line on one side).
   bool straight = false;
+  // Zero-lag closure for fluid-driven cracks: an end tip does not grow while
+  // it lies more than max_lag_cells cells (along the crack) beyond the fluid
+  // front the fluid reported. Negative: no limit (and no effect without a fluid).
+  double max_lag_cells = -1;
 };
 
 struct SolidConfig {

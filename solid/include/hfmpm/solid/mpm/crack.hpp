@@ -39,6 +39,10 @@ class Crack {
   // Pa, the pressure on the faces at the current width w:
   // max(0, p - stiffness (w - reference width)).
   double face_pressure(std::size_t k) const;
+  // Arc length from the first particle that the fluid has wetted (its front,
+  // m), or negative when no fluid reports one.
+  double wetted_length() const { return wetted_length_; }
+  void set_wetted_length(double s) { wetted_length_ = s; }
   bool start_is_tip() const { return start_is_tip_; }
   bool end_is_tip() const { return end_is_tip_; }
 
@@ -74,6 +78,7 @@ class Crack {
   std::vector<Vec2> plane_, above_, below_;
   std::vector<double> pressure_;  // Pa, on the faces, per crack particle
   std::vector<double> stiffness_, reference_width_;  // Pa/m and m, per crack particle
+  double wetted_length_ = -1;
   std::uint64_t next_id_ = 0;
   // Side-test geometry: the plane polyline with extended mouth ends.
   std::vector<Vec2> path_;

@@ -79,6 +79,8 @@ class Solver {
   // size, or empty): the faces then carry p - stiffness (w - width).
   void set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
                           const std::vector<double>& stiffness = {}, const std::vector<double>& width = {});
+  // The fluid front on crack c: arc length (m) from its first particle.
+  void set_crack_front(std::size_t c, double arc_length);
 
   // J, K_I, K_II and the kink angle at every tip, evaluated now (one pass
   // over the particles near the tips). Quasi-static J: no kinetic terms.
