@@ -17,11 +17,38 @@
 //   stress once the ramp is over, the mouth opens, and the crack grows.
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "coupled_support.hpp"
 
 namespace hfmpm::test {
 namespace {
+
+// The columns of a KGD run's history.csv that the checks use.
+struct KgdHistory {
+  std::vector<double> t, length, mouth, p_in, injected, volume, ke;
+  double dt_max = 0;  // the largest coupled step, s
+};
+KgdHistory read_kgd_history(const std::string& out) {
+  const Csv h = read_csv(out + "/history.csv");
+  KgdHistory k{h.values("time_s"),           h.values("crack_length_m"),     h.values("mouth_opening_m"),
+               h.values("inlet_pressure_pa"), h.values("injected_volume_m2"), h.values("fluid_volume_m2"),
+               h.values("kinetic_energy_j")};
+  const auto dt = h.values("dt_s");
+  k.dt_max = dt.empty() ? 0.0 : *std::max_element(dt.begin(), dt.end());
+  return k;
+}
+
+// Volume injected by time t by a rate ramped linearly from 0 to q over
+// `ramp` s, and the tolerance on it: the inlet integrates the rate by the
+// trapezoid rule per fluid substep, exact but for the substep holding the
+// ramp's kink, which errs by at most (q / ramp) dt^2 / 8 (dt <= the coupled
+// step; measured 2.3e-13 m^2), plus round-off.
+double ramp_volume(double q, double ramp, double t) {
+  return t >= ramp ? q * (t - 0.5 * ramp) : 0.5 * q * t * t / ramp;
+}
+double ramp_tolerance(double q, double ramp, double dt_max) { return q / ramp * dt_max * dt_max / 8 + 1e-9 * q; }
 
 TEST(KgdScene, ToughnessSceneRunsStablyConservesFluidAndGrows) {
   const auto out = scratch_dir("kgd_toughness");
@@ -30,22 +57,14 @@ TEST(KgdScene, ToughnessSceneRunsStablyConservesFluidAndGrows) {
   text = replace_once(text, "interval_s: 0.25", "interval_s: 0.05");
   const auto result = run_scene(text, out, {"--set", "output.hdf5=false"}, 900);
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  const Csv h = read_csv(out + "/history.csv");
-  const auto t = h.values("time_s"), length = h.values("crack_length_m"), mouth = h.values("mouth_opening_m");
-  const auto p_in = h.values("inlet_pressure_pa"), injected = h.values("injected_volume_m2");
-  const auto volume = h.values("fluid_volume_m2"), ke = h.values("kinetic_energy_j");
+  const auto [t, length, mouth, p_in, injected, volume, ke, dt_max] = read_kgd_history(out);
   ASSERT_GE(t.size(), 10u);
   constexpr double kQ = 4.15e-4, kRamp = 0.05, kSigma0 = 1e5, kK = 2e6, kC = 0.0894;
-  const auto dt = h.values("dt_s");
-  const double dt_max = *std::max_element(dt.begin(), dt.end());
   constexpr double kInitial = 0.2 * 2e-5;     // the notch's fluid at 1e5 Pa: the virtual film x 0.2 m
   double work = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     for (double v : {length[i], mouth[i], p_in[i], injected[i], volume[i], ke[i]}) ASSERT_TRUE(std::isfinite(v));
-    const double exact = t[i] >= kRamp ? kQ * (t[i] - 0.5 * kRamp) : 0.5 * kQ * t[i] * t[i] / kRamp;
-    // Trapezoid per fluid substep: exact but for the substep holding the
-    // ramp's kink, at most (Q / t_ramp) dt^2 / 8 off.
-    EXPECT_NEAR(injected[i], exact, kQ / kRamp * dt_max * dt_max / 8 + 1e-9 * kQ) << "t = " << t[i];
+    EXPECT_NEAR(injected[i], ramp_volume(kQ, kRamp, t[i]), ramp_tolerance(kQ, kRamp, dt_max)) << "t = " << t[i];
     if (i > 0) work += 0.5 * (p_in[i] + p_in[i - 1]) * (injected[i] - injected[i - 1]);
     if (t[i] > 0.1) {
       EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
@@ -111,16 +130,11 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
   const auto out = scratch_dir("kgd_ci");
   const auto result = run_scene(read_file(source(scene)), out, {"--set", "output.hdf5=false"}, 900);
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  const Csv h = read_csv(out + "/history.csv");
-  const auto t = h.values("time_s"), length = h.values("crack_length_m"), mouth = h.values("mouth_opening_m");
-  const auto p_in = h.values("inlet_pressure_pa"), injected = h.values("injected_volume_m2");
-  const auto volume = h.values("fluid_volume_m2"), ke = h.values("kinetic_energy_j");
+  const auto [t, length, mouth, p_in, injected, volume, ke, dt_max] = read_kgd_history(out);
   ASSERT_GE(t.size(), 20u);
   ASSERT_NEAR(t.back(), 5, 1e-3);
   constexpr double kRamp = 0.05, kSigma0 = 1e5, kNotch = 0.15;
   constexpr double kInitial = kNotch * 2e-5;  // the notch's fluid: the virtual film x 0.15 m
-  const auto dt = h.values("dt_s");
-  const double dt_max = *std::max_element(dt.begin(), dt.end());
   const double p_max = *std::max_element(p_in.begin(), p_in.end());
   const double j_min = 1 - 0.0894 * std::log1p(p_max / (0.0894 * 2e6));  // Tait, c = 0.0894, K = 2 MPa
   double work = 0, worst_length = 0, worst_opening = 0, worst_pressure = 0;
@@ -128,11 +142,7 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
   for (std::size_t i = 0; i < t.size(); ++i) {
     for (double v : {length[i], mouth[i], p_in[i], injected[i], volume[i], ke[i]}) ASSERT_TRUE(std::isfinite(v));
     const double q = 0.5 * Q;  // into the modelled wing
-    const double exact = t[i] >= kRamp ? q * (t[i] - 0.5 * kRamp) : 0.5 * q * t[i] * t[i] / kRamp;
-    // The inlet integrates Q(t) by the trapezoid rule per fluid substep: exact
-    // but for the substep holding the ramp's kink, which errs by at most
-    // (q / t_ramp) dt^2 / 8 (dt <= the coupled step; measured 2.3e-13 m^2).
-    EXPECT_NEAR(injected[i], exact, q / kRamp * dt_max * dt_max / 8 + 1e-9 * q) << "t = " << t[i];
+    EXPECT_NEAR(injected[i], ramp_volume(q, kRamp, t[i]), ramp_tolerance(q, kRamp, dt_max)) << "t = " << t[i];
     if (i > 0) work += 0.5 * (p_in[i] + p_in[i - 1]) * (injected[i] - injected[i - 1]);
     if (t[i] > 0.1) {
       EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
