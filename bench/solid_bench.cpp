@@ -60,18 +60,14 @@ SolidConfig cracked(int cells_per_a, int threads) {
 
 // Bytes the solver holds per particle: the particle arrays as allocated (x, v,
 // mass, volume, half size, stress, material; displacement and its gradient
-// only in cracked scenes) plus grid arrays / particles.
+// only in cracked scenes) plus the grid's arrays as allocated / particles.
 double bytes_per_particle(const Solver& solid) {
   const auto& p = solid.particles();
   auto bytes = [](const auto& v) { return static_cast<double>(v.capacity() * sizeof(v[0])); };
   const double particle = (bytes(p.x) + bytes(p.v) + bytes(p.displacement) + bytes(p.grad_u) + bytes(p.mass) +
                            bytes(p.volume) + bytes(p.half_size) + bytes(p.stress) + bytes(p.material)) /
                           static_cast<double>(p.size());
-  // mass, momentum, force, displaced, fixed; velocity and acceleration; stamp
-  const double per_node = sizeof(double) + 3 * sizeof(Vec2) + 1 + 2 * sizeof(Vec2) + sizeof(std::uint32_t);
-  const double fields = solid.cracks().empty() ? 1 : 2;
-  const double threads = static_cast<double>(solid.config().threads);
-  const double grid = static_cast<double>(solid.grid().node_count()) * per_node * fields * (1 + threads);
+  const double grid = static_cast<double>(solid.grid_bytes());  // fields, velocities, P2G's accumulators
   return particle + grid / static_cast<double>(p.size());
 }
 

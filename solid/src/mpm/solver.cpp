@@ -49,22 +49,18 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
     velocity_[f].assign(n, Vec2::Zero());
     acceleration_[f].assign(n, Vec2::Zero());
   }
-  const int threads = std::max(1, config_.threads);
-  thread_nodes_.resize(static_cast<std::size_t>(threads));
-  thread_second_.resize(static_cast<std::size_t>(threads));
-  thread_touched_.resize(static_cast<std::size_t>(threads));
-  thread_stamp_.resize(static_cast<std::size_t>(threads));
-  for (int k = 0; k < threads; ++k) {
-    thread_nodes_[static_cast<std::size_t>(k)].resize(n);
-    if (cracked) thread_second_[static_cast<std::size_t>(k)].resize(n);
-    thread_stamp_[static_cast<std::size_t>(k)].assign(n, 0);
-  }
+  const auto threads = static_cast<std::size_t>(std::max(1, config_.threads));
+  thread_acc_.resize(threads);
+  thread_span_.assign(threads, {0, 0});
+  thread_active_.resize(threads);
+  for (auto& acc : thread_acc_) acc.resize(n * static_cast<std::size_t>(fields));
   if (cracked) second_.resize(n);
   generate_particles();
   if (cracked) {
     particles_.displacement.assign(particles_.size(), Vec2::Zero());
     particles_.grad_u.assign(particles_.size(), Eigen::Matrix2d::Zero());
   }
+  if (cracked) sides_.assign(particles_.size(), 0);
   build_constraints();
   find_edges();
   double lightest = std::numeric_limits<double>::infinity();
@@ -193,21 +189,41 @@ void Solver::step(double dt) {
 template <bool kCracks>
 void Solver::p2g() {
   const auto& g = config_.grid;
-  const int threads = static_cast<int>(thread_nodes_.size());
+  const auto threads = thread_acc_.size();
   const std::size_t count = particles_.size();
+  constexpr std::size_t F = kCracks ? 2 : 1;  // fields per node in the accumulators
+  const std::size_t row = static_cast<std::size_t>(g.nodes_x());
   const std::uint32_t epoch = epoch_;
-#pragma omp parallel num_threads(threads)
+  if constexpr (kCracks) {
+    if (sides_.size() != count) sides_.assign(count, 0);
+  }
+#pragma omp parallel num_threads(static_cast<int>(threads))
   {
     const auto k = static_cast<std::size_t>(omp_get_thread_num());
-    auto& f0 = thread_nodes_[k];
-    auto& f1 = thread_second_[k];
-    auto& touched = thread_touched_[k];
-    auto& stamp = thread_stamp_[k];
-    touched.clear();
-    const std::size_t begin = count * k / thread_nodes_.size();
-    const std::size_t end = count * (k + 1) / thread_nodes_.size();
+    auto& acc = thread_acc_[k];
+    const std::size_t begin = count * k / threads;
+    const std::size_t end = count * (k + 1) / threads;
+    // The rows of nodes this thread's particles reach (particles are stored
+    // row by row, so each thread's span is a band of the grid): zero them.
+    double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
     for (std::size_t p = begin; p < end; ++p) {
-      const Vec2 rel = particles_.x[p] - g.origin;
+      y_lo = std::min(y_lo, particles_.x[p].y());
+      y_hi = std::max(y_hi, particles_.x[p].y());
+    }
+    std::array<std::size_t, 2> span{0, 0};
+    if (begin < end) {
+      const auto row_of = [&](double y) { return static_cast<int>(std::floor((y - g.origin.y()) / g.h + 0.5)); };
+      // One row more each way than the stencil's reach, against rounding.
+      const int j0 = std::clamp(row_of(y_lo) - 2, 0, g.ny);
+      const int j1 = std::clamp(row_of(y_hi) + 2, 0, g.ny);
+      span = {static_cast<std::size_t>(j0) * row, static_cast<std::size_t>(j1 + 1) * row};
+      std::fill(acc.begin() + static_cast<std::ptrdiff_t>(span[0] * F),
+                acc.begin() + static_cast<std::ptrdiff_t>(span[1] * F), NodeAcc{});
+    }
+    thread_span_[k] = span;
+    for (std::size_t p = begin; p < end; ++p) {
+      const Vec2 x = particles_.x[p];
+      const Vec2 rel = x - g.origin;
       const double lp = particles_.half_size[p];
       const auto sx = ugimp_stencil(rel.x(), g.h, lp);
       const auto sy = ugimp_stencil(rel.y(), g.h, lp);
@@ -215,69 +231,94 @@ void Solver::p2g() {
       const Vec2 mv = m * particles_.v[p];
       const Voigt& s = particles_.stress[p];
       const double vol = particles_.volume[p];
-      const bool near = kCracks && near_crack(particles_.x[p]);
+      bool near = false;
+      std::uint16_t sides = 0;
+      Vec2 mu = Vec2::Zero();
+      if constexpr (kCracks) {
+        near = near_crack(x);
+        if (near) sides = 1u << 15;
+        mu = m * particles_.displacement[p];
+      }
       for (int b = 0; b < 3; ++b) {
         const int j = sy.first + b;
         if (j < 0 || j > g.ny) continue;
+        const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
         for (int a = 0; a < 3; ++a) {
           const int i = sx.first + a;
           if (i < 0 || i > g.nx) continue;
-          const double w = sx.s[static_cast<std::size_t>(a)] * sy.s[static_cast<std::size_t>(b)];
+          const double w = sx.s[static_cast<std::size_t>(a)] * syb;
           if (w == 0) continue;
-          const double gx = sx.g[static_cast<std::size_t>(a)] * sy.s[static_cast<std::size_t>(b)];
-          const double gy = sx.s[static_cast<std::size_t>(a)] * sy.g[static_cast<std::size_t>(b)];
+          const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
+          const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
           const auto n = static_cast<std::size_t>(g.node(i, j));
-          if (stamp[n] != epoch) {
-            stamp[n] = epoch;
-            touched.push_back(static_cast<int>(n));
-            f0.mass[n] = 0;
-            f0.momentum[n].setZero();
-            f0.force[n].setZero();
-            if constexpr (kCracks) {
-              f0.displaced[n].setZero();
-              f1.mass[n] = 0;
-              f1.momentum[n].setZero();
-              f1.force[n].setZero();
-              f1.displaced[n].setZero();
+          std::size_t slot = n * F;
+          if constexpr (kCracks) {
+            if (near && field_of(x, g.position(static_cast<int>(n)))) {
+              ++slot;
+              sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
             }
           }
-          auto& f = (near && field_of(particles_.x[p], g.position(static_cast<int>(n)))) ? f1 : f0;
-          f.mass[n] += w * m;
-          f.momentum[n] += w * mv;
-          if constexpr (kCracks) f.displaced[n] += w * m * particles_.displacement[p];
+          NodeAcc& f = acc[slot];
+          f.m += w * m;
+          f.px += w * mv.x();
+          f.py += w * mv.y();
           // internal force -V sigma . grad S (s = xx, yy, xy, zz)
-          f.force[n] -= vol * Vec2(s[0] * gx + s[2] * gy, s[2] * gx + s[1] * gy);
+          f.fx -= vol * (s[0] * gx + s[2] * gy);
+          f.fy -= vol * (s[2] * gx + s[1] * gy);
+          if constexpr (kCracks) {
+            f.ux += w * mu.x();
+            f.uy += w * mu.y();
+          }
+        }
+      }
+      if constexpr (kCracks) sides_[p] = sides;
+    }
+#pragma omp barrier
+    // Reduce the spans into the fields: each thread a slice of the nodes.
+    std::size_t lo = std::numeric_limits<std::size_t>::max(), hi = 0;
+    for (const auto& sp : thread_span_) {
+      if (sp[0] < sp[1]) {
+        lo = std::min(lo, sp[0]);
+        hi = std::max(hi, sp[1]);
+      }
+    }
+    auto& active = thread_active_[k];
+    active.clear();
+    if (lo < hi) {
+      const std::size_t first = lo + (hi - lo) * k / threads, last = lo + (hi - lo) * (k + 1) / threads;
+      for (std::size_t u = first; u < last; ++u) {
+        NodeAcc sum[F] = {};
+        for (std::size_t t = 0; t < threads; ++t) {
+          const auto& sp = thread_span_[t];
+          if (u < sp[0] || u >= sp[1]) continue;
+          for (std::size_t f = 0; f < F; ++f) {
+            const NodeAcc& from = thread_acc_[t][u * F + f];
+            sum[f].m += from.m;
+            sum[f].px += from.px;
+            sum[f].py += from.py;
+            sum[f].fx += from.fx;
+            sum[f].fy += from.fy;
+            sum[f].ux += from.ux;
+            sum[f].uy += from.uy;
+          }
+        }
+        bool touched = sum[0].m > 0;
+        if constexpr (kCracks) touched = touched || sum[1].m > 0;
+        if (!touched) continue;
+        stamp_[u] = epoch;
+        active.push_back(static_cast<int>(u));
+        for (std::size_t f = 0; f < F; ++f) {
+          NodalFields& to = f ? second_ : nodes_;
+          to.mass[u] = sum[f].m;
+          to.momentum[u] = Vec2(sum[f].px, sum[f].py);
+          to.force[u] = Vec2(sum[f].fx, sum[f].fy);
+          if constexpr (kCracks) to.displaced[u] = Vec2(sum[f].ux, sum[f].uy);
         }
       }
     }
   }
-  // Reduce the threads' fields into the active nodes.
   active_.clear();
-  auto merge = [&](NodalFields& to, const NodalFields& from, std::size_t u, bool first) {
-    if (first) {
-      to.mass[u] = from.mass[u];
-      to.momentum[u] = from.momentum[u];
-      to.force[u] = from.force[u];
-      if constexpr (kCracks) to.displaced[u] = from.displaced[u];
-    } else {
-      to.mass[u] += from.mass[u];
-      to.momentum[u] += from.momentum[u];
-      to.force[u] += from.force[u];
-      if constexpr (kCracks) to.displaced[u] += from.displaced[u];
-    }
-  };
-  for (std::size_t k = 0; k < thread_nodes_.size(); ++k) {
-    for (int n : thread_touched_[k]) {
-      const auto u = static_cast<std::size_t>(n);
-      const bool first = stamp_[u] != epoch;
-      if (first) {
-        stamp_[u] = epoch;
-        active_.push_back(n);
-      }
-      merge(nodes_, thread_nodes_[k], u, first);
-      if constexpr (kCracks) merge(second_, thread_second_[k], u, first);
-    }
-  }
+  for (const auto& part : thread_active_) active_.insert(active_.end(), part.begin(), part.end());
 }
 
 // Tractions and dashpots act on the body's edge: each edge particle carries
@@ -366,14 +407,15 @@ void Solver::g2p(double dt) {
   const Vec2 lo = g.origin, hi = g.origin + g.h * Vec2(g.nx, g.ny);
   const auto count = static_cast<std::int64_t>(particles_.size());
   std::int64_t escaped = -1;
-#pragma omp parallel for num_threads(static_cast<int>(thread_nodes_.size())) schedule(static)
+#pragma omp parallel for num_threads(static_cast<int>(thread_acc_.size())) schedule(static)
   for (std::int64_t q = 0; q < count; ++q) {
     const auto p = static_cast<std::size_t>(q);
     const Vec2 rel = particles_.x[p] - g.origin;
     const double lp = particles_.half_size[p];
     const auto sx = ugimp_stencil(rel.x(), g.h, lp);
     const auto sy = ugimp_stencil(rel.y(), g.h, lp);
-    const bool near = kCracks && near_crack(particles_.x[p]);
+    std::uint16_t sides = 0;
+    if constexpr (kCracks) sides = sides_[p];  // the fields P2G found for its nodes
     Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
     double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
     for (int b = 0; b < 3; ++b) {
@@ -387,7 +429,7 @@ void Solver::g2p(double dt) {
         const double gx = sx.g[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
         const double gy = sx.s[static_cast<std::size_t>(c)] * sy.g[static_cast<std::size_t>(b)];
         const auto n = static_cast<std::size_t>(g.node(i, j));
-        const int field = near ? field_of(particles_.x[p], g.position(static_cast<int>(n))) : 0;
+        const int field = (sides >> (3 * b + c)) & 1;
         const Vec2& vn = velocity_[field][n];
         v_new += w * vn;
         a += w * acceleration_[field][n];
@@ -428,6 +470,17 @@ void Solver::g2p(double dt) {
         << "boundary conditions and loads";
     throw std::runtime_error(out.str());
   }
+}
+
+std::size_t Solver::grid_bytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  auto fields = [&](const NodalFields& f) {
+    return bytes(f.mass) + bytes(f.momentum) + bytes(f.force) + bytes(f.displaced) + bytes(f.fixed);
+  };
+  std::size_t total = fields(nodes_) + fields(second_) + bytes(stamp_) + bytes(active_);
+  for (int f = 0; f < 2; ++f) total += bytes(velocity_[f]) + bytes(acceleration_[f]);
+  for (const auto& acc : thread_acc_) total += bytes(acc);
+  return total;
 }
 
 template void Solver::p2g<false>();

@@ -44,7 +44,9 @@ struct RunSummary {
   double stepping_wall_s = 0; // from the first StepCommand to the last report
   double solid_compute_s = 0, fluid_compute_s = 0;
   double solid_exchange_s = 0, fluid_exchange_s = 0;
-  // stepping_wall_s minus the slower side's compute time, per step.
+  bool sides_in_sequence = false;  // Gauss-Seidel: the fluid steps after the solid, not beside it
+  // stepping_wall_s minus the sides' compute time, per step: minus the slower
+  // side's when they step side by side (Jacobi), minus both when in sequence.
   double overhead_per_step_us() const;
 };
 

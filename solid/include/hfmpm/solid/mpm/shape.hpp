@@ -45,17 +45,33 @@ struct Stencil1D {
 };
 
 // x: particle coordinate relative to the grid origin, h: cell size, lp: half-width.
+// The same weights as ugimp_1d at the 3 nodes, with two divisions instead of
+// a dozen (this runs twice per particle and step).
 inline Stencil1D ugimp_stencil(double x, double h, double lp) {
   Stencil1D st;
-  const double xi = x / h;
+  const double inv_h = 1 / h, inv_hlp = 1 / (h * lp);
   // The nearest node: the particle's box [x - lp, x + lp] with lp <= h/2 lies
   // within (nearest - 1) .. (nearest + 1) cells' support.
-  const int nearest = static_cast<int>(std::floor(xi + 0.5));
+  const int nearest = static_cast<int>(std::floor(x * inv_h + 0.5));
   st.first = nearest - 1;
   for (int k = 0; k < 3; ++k) {
-    const auto w = ugimp_1d(x - (st.first + k) * h, h, lp);
-    st.s[static_cast<std::size_t>(k)] = w.s;
-    st.g[static_cast<std::size_t>(k)] = w.g;
+    const double d = x - (st.first + k) * h;
+    const double a = std::abs(d);
+    const double sign = d < 0 ? -1.0 : 1.0;
+    double s = 0, g = 0;
+    if (a < lp) {
+      s = 1 - 0.5 * (d * d + lp * lp) * inv_hlp;
+      g = -d * inv_hlp;
+    } else if (a <= h - lp) {
+      s = 1 - a * inv_h;
+      g = -sign * inv_h;
+    } else if (a < h + lp) {
+      const double r = h + lp - a;
+      s = 0.25 * r * r * inv_hlp;
+      g = -0.5 * sign * r * inv_hlp;
+    }
+    st.s[static_cast<std::size_t>(k)] = s;
+    st.g[static_cast<std::size_t>(k)] = g;
   }
   return st;
 }

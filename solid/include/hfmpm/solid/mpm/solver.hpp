@@ -12,6 +12,8 @@
 // damped, quasi-static loading of hydraulic fracture.
 #pragma once
 
+#include <array>
+
 #include <cstdint>
 #include <vector>
 
@@ -61,6 +63,9 @@ class Solver {
   const Particles& particles() const { return particles_; }
   const NodalFields& nodes() const { return nodes_; }
   const std::vector<int>& active_nodes() const { return active_; }
+  // Bytes of the grid's arrays as allocated: reduced fields, velocities and
+  // accelerations, P2G's per-thread accumulators (for memory reports).
+  std::size_t grid_bytes() const;
   // Particles on each edge of the body (Left, Right, Bottom, Top), found once.
   const std::vector<std::uint32_t>& edge_particles(Edge edge) const {
     return edges_[static_cast<std::size_t>(edge)];
@@ -128,10 +133,18 @@ class Solver {
   NodalFields nodes_;                 // reduced fields, field 0
   NodalFields second_;                // field 1 (other side of a crack); sized only with cracks
   std::vector<Crack> cracks_;
-  std::vector<NodalFields> thread_nodes_;
-  std::vector<NodalFields> thread_second_;
-  std::vector<std::vector<int>> thread_touched_;
-  std::vector<std::vector<std::uint32_t>> thread_stamp_;
+  // P2G's per-thread accumulators: one cache line per node and field
+  // (index node * fields + field), over the span of nodes the thread's
+  // particles reach this step; the spans are reduced into nodes_ / second_.
+  struct alignas(64) NodeAcc {
+    double m, px, py, fx, fy, ux, uy, pad;
+  };
+  std::vector<std::vector<NodeAcc>> thread_acc_;
+  std::vector<std::array<std::size_t, 2>> thread_span_;  // [first, last) node
+  std::vector<std::vector<int>> thread_active_;
+  // Per particle, cracks only, set by P2G for G2P: bit 15 = near a crack,
+  // bit 3 b + a = node (a, b) of its 3 x 3 stencil is in field 1.
+  std::vector<std::uint16_t> sides_;
   std::vector<std::uint32_t> stamp_;
   std::vector<int> active_;
   std::vector<Vec2> velocity_[2];     // new nodal velocity, per field and node
