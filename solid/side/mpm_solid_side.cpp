@@ -99,7 +99,7 @@ class MpmSolidSide final : public coupling::SideModel {
     writer_->begin_frame(t, solver_->steps());
     writer_->points("particles", p.x);
     writer_->vector("particles", "velocity", p.v);
-    writer_->tensor("particles", "stress", p.stress);
+    writer_->tensor("particles", "stress", solver_->total_stresses());
     writer_->integer("particles", "material", p.material);
     for (const auto& crack : solver_->cracks()) {
       const std::string set = "crack" + std::to_string(crack.id());
@@ -246,6 +246,7 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   c.fracture.straight = s.fracture().direction() == scene::FractureSpec::STRAIGHT;
   if (s.fracture().has_max_lag_cells()) c.fracture.max_lag_cells = s.fracture().max_lag_cells();
   c.implicit_face_stiffness = s.implicit_face_stiffness();
+  c.in_situ_reference = s.in_situ_reference();
   c.threads = static_cast<int>(s.threads());
   for (const auto& cr : s.cracks()) {
     mpm::CrackSpec spec;

@@ -266,11 +266,8 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
     const Vec2 t = (crack.plane()[b] - crack.plane()[a]).normalized();
     const Vec2 n_up(-t.y(), t.x());
     Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
-    const int region = region_at(mid);
-    if (region >= 0) {
-      const Voigt& s0 = config_.regions[static_cast<std::size_t>(region)].initial_stress;
-      load += Vec2(s0[0] * n_up.x() + s0[2] * n_up.y(), s0[2] * n_up.x() + s0[1] * n_up.y());
-    }
+    const Voigt s0 = in_situ_stress(mid);
+    load += Vec2(s0[0] * n_up.x() + s0[2] * n_up.y(), s0[2] * n_up.x() + s0[1] * n_up.y());
     j_faces -= q * load.dot(jump(b) - jump(a));
     const double step = aux_jump(b) - aux_jump(a);
     m1_faces -= q * load.dot(e2) * step;

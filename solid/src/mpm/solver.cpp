@@ -87,7 +87,12 @@ void Solver::generate_particles() {
           if (!found) continue;
           const auto mat = static_cast<std::size_t>(found->material);
           const double volume = spacing * spacing;
-          particles_.add(x, density_[mat] * volume, volume, spacing / 2, found->initial_stress, found->material);
+          if (config_.in_situ_reference) {
+            particles_.add(x, density_[mat] * volume, volume, spacing / 2, Voigt::Zero(), found->material);
+            particles_.region.push_back(static_cast<std::int32_t>(found - config_.regions.data()));
+          } else {
+            particles_.add(x, density_[mat] * volume, volume, spacing / 2, found->initial_stress, found->material);
+          }
         }
       }
     }
@@ -359,6 +364,19 @@ void Solver::edge_loads() {
       spread(p, n, t * 2 * particles_.half_size[p]);
     }
   }
+  if (config_.in_situ_reference) {
+    // The particles carry no in-situ stress, so no edge holds its traction
+    // sigma0 n: every edge gets -sigma0 n on top of its own load (on a
+    // symmetry plane the constraint takes the normal part).
+    for (Edge edge : {Edge::Left, Edge::Right, Edge::Bottom, Edge::Top}) {
+      const Vec2 n = outward_normal(edge);
+      for (std::uint32_t p : edges_[static_cast<std::size_t>(edge)]) {
+        const Voigt& s0 = config_.regions[static_cast<std::size_t>(particles_.region[p])].initial_stress;
+        const Vec2 t0(s0[0] * n.x() + s0[2] * n.y(), s0[2] * n.x() + s0[1] * n.y());
+        if (t0.squaredNorm() > 0) spread(p, n, -t0 * 2 * particles_.half_size[p]);
+      }
+    }
+  }
   for (Edge edge : config_.silent_edges) {
     // Lysmer-Kuhlemeyer dashpots: t = -rho (c_p v_n n + c_s v_t t)
     const Vec2 n = outward_normal(edge);
@@ -470,6 +488,46 @@ void Solver::g2p(double dt) {
         << "boundary conditions and loads";
     throw std::runtime_error(out.str());
   }
+}
+
+Voigt Solver::total_stress(std::size_t p) const {
+  if (!config_.in_situ_reference) return particles_.stress[p];
+  return particles_.stress[p] + config_.regions[static_cast<std::size_t>(particles_.region[p])].initial_stress;
+}
+
+std::vector<Voigt> Solver::total_stresses() const {
+  std::vector<Voigt> out(particles_.size());
+  for (std::size_t p = 0; p < out.size(); ++p) out[p] = total_stress(p);
+  return out;
+}
+
+Voigt Solver::in_situ_stress(const Vec2& x) const {
+  int r = region_at(x);
+  if (r < 0) {
+    // A crack's mouth on the body's edge may sit a round-off outside it:
+    // take the nearest region (by its bounding box) within a cell.
+    double best = config_.grid.h;
+    for (std::size_t k = 0; k < config_.regions.size(); ++k) {
+      const Region& reg = config_.regions[k];
+      Vec2 lo = reg.lo, hi = reg.hi;
+      if (reg.kind == Region::Kind::Layer) {
+        lo.x() = -std::numeric_limits<double>::infinity();
+        hi.x() = std::numeric_limits<double>::infinity();
+      } else if (reg.kind == Region::Kind::Polygon && !reg.polygon.empty()) {
+        lo = hi = reg.polygon.front();
+        for (const auto& v : reg.polygon) {
+          lo = lo.cwiseMin(v);
+          hi = hi.cwiseMax(v);
+        }
+      }
+      const double d = (x - x.cwiseMax(lo).cwiseMin(hi)).norm();
+      if (d <= best) {
+        best = d;
+        r = static_cast<int>(k);
+      }
+    }
+  }
+  return r < 0 ? Voigt::Zero() : config_.regions[static_cast<std::size_t>(r)].initial_stress;
 }
 
 std::size_t Solver::grid_bytes() const {

@@ -99,6 +99,17 @@ struct SolidConfig {
   // (solver_cracks.cpp). Off: the pressure is explicit, which is unstable
   // for dt above about sqrt(rho h w / K_fluid).
   bool implicit_face_stiffness = true;
+  // The regions' initial stress as the reference state: particles carry only
+  // the change of stress from it, and every load acts as its change from the
+  // in-situ tractions (edges: t - sigma0 n; crack faces: p n + sigma0 n).
+  // For linear elasticity and frictionless contact this is the same problem
+  // (superposition) when the in-situ stress is in equilibrium (uniform in
+  // each region, tractions continuous across region interfaces). It removes
+  // what the discretization gets wrong in proportion to the in-situ stress:
+  // the load a crack tip particle cannot carry (its two sides fall in one
+  // field) and the in-situ stress the first row of particles along a grown
+  // crack loses as the tip passes (docs/solid.md).
+  bool in_situ_reference = false;
   int threads = 1;
 };
 

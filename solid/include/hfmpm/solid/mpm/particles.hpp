@@ -18,12 +18,16 @@ struct Particles {
   std::vector<double> mass;       // kg/m (after density scaling)
   std::vector<double> volume;     // m^2, initial area (small strain: kept constant)
   std::vector<double> half_size;  // m, uGIMP half-width lp
-  std::vector<Voigt> stress;      // Pa, Cauchy stress including the initial stress
+  std::vector<Voigt> stress;      // Pa, Cauchy stress including the initial stress (with
+                                  // in_situ_reference: its change from it; Solver::total_stress)
   // Kept only with cracks (empty otherwise): contact needs the displacement,
   // the J-integral its gradient.
   std::vector<Vec2> displacement;  // m, since the start
   std::vector<Eigen::Matrix2d> grad_u;  // du_i/dx_j since the start (small strain)
   std::vector<std::int32_t> material;  // index into the material table
+  // Kept only with SolidConfig::in_situ_reference (empty otherwise): the
+  // region whose initial stress the particle's stress is measured from.
+  std::vector<std::int32_t> region;
 
   std::size_t size() const { return x.size(); }
   void add(const Vec2& position, double m, double v0, double lp, const Voigt& initial_stress, std::int32_t mat) {
@@ -43,6 +47,7 @@ struct Particles {
     half_size.shrink_to_fit();
     stress.shrink_to_fit();
     material.shrink_to_fit();
+    region.shrink_to_fit();
   }
 };
 

@@ -63,6 +63,13 @@ class Solver {
   const Particles& particles() const { return particles_; }
   const NodalFields& nodes() const { return nodes_; }
   const std::vector<int>& active_nodes() const { return active_; }
+  // Particle p's Cauchy stress (Pa): the stored stress, plus its region's
+  // initial stress when the particles carry changes (in_situ_reference).
+  Voigt total_stress(std::size_t p) const;
+  std::vector<Voigt> total_stresses() const;
+  // The in-situ stress at x: the initial stress of the region there (the
+  // last region containing x), zero outside every region.
+  Voigt in_situ_stress(const Vec2& x) const;
   // Bytes of the grid's arrays as allocated: reduced fields, velocities and
   // accelerations, P2G's per-thread accumulators (for memory reports).
   std::size_t grid_bytes() const;
