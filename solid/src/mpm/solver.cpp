@@ -425,6 +425,7 @@ void Solver::g2p(double dt) {
   const Vec2 lo = g.origin, hi = g.origin + g.h * Vec2(g.nx, g.ny);
   const auto count = static_cast<std::int64_t>(particles_.size());
   std::int64_t escaped = -1;
+  const double runaway = g.h;  // m per step
 #pragma omp parallel for num_threads(static_cast<int>(thread_acc_.size())) schedule(static)
   for (std::int64_t q = 0; q < count; ++q) {
     const auto p = static_cast<std::size_t>(q);
@@ -474,20 +475,56 @@ void Solver::g2p(double dt) {
     const double tr = dxx + dyy;
     particles_.stress[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
     const Vec2& x = particles_.x[p];
-    if (!(x.x() >= lo.x() && x.y() >= lo.y() && x.x() <= hi.x() && x.y() <= hi.y())) {
+    // A particle that leaves the grid, becomes NaN, or moves more than a
+    // cell in one step (|v| > 2 c_p at the largest valid CFL factor; the
+    // shape functions cannot follow that) has run away.
+    if (!(x.x() >= lo.x() && x.y() >= lo.y() && x.x() <= hi.x() && x.y() <= hi.y()) ||
+        !(dt * v_new.norm() <= runaway)) {
 #pragma omp critical
       escaped = q;
     }
   }
-  if (escaped >= 0) {
-    const auto p = static_cast<std::size_t>(escaped);
-    std::ostringstream out;
-    out << "particle " << p << " left the grid (or became NaN) at step " << steps_ + 1 << ": x = ("
-        << particles_.x[p].x() << ", " << particles_.x[p].y() << ") m, v = (" << particles_.v[p].x() << ", "
-        << particles_.v[p].y() << ") m/s; the step is probably unstable: lower the CFL factor or check the "
-        << "boundary conditions and loads";
-    throw std::runtime_error(out.str());
+  if (escaped >= 0) throw std::runtime_error(runaway_report(static_cast<std::size_t>(escaped), dt));
+}
+
+// What a run that blew up needs to be told: which particle, where, how fast,
+// and the loads that can drive it, with what to change.
+std::string Solver::runaway_report(std::size_t p, double dt) const {
+  const auto& g = config_.grid;
+  std::ostringstream out;
+  out << "the solid ran away at step " << steps_ + 1 << " (t = " << t_ + dt << " s): particle " << p << " at x = ("
+      << particles_.x[p].x() << ", " << particles_.x[p].y() << ") m moved at v = (" << particles_.v[p].x() << ", "
+      << particles_.v[p].y() << ") m/s, " << dt * particles_.v[p].norm() / g.h
+      << " cells in one step (the limit is 1; NaN or off the grid counts too). ";
+  // The largest crack face pressure: a fluid pressure spike (a flow-rate
+  // inlet into a film too thin to carry it) shows here.
+  double p_max = 0;
+  Vec2 where = Vec2::Zero();
+  std::uint32_t crack_id = 0;
+  for (const auto& crack : cracks_) {
+    for (std::size_t k = 0; k < crack.size(); ++k) {
+      if (crack.face_pressure(k) > p_max) {
+        p_max = crack.face_pressure(k);
+        where = crack.plane()[k];
+        crack_id = crack.id();
+      }
+    }
   }
+  double stress_max = 0;
+  for (const auto& m : config_.regions) stress_max = std::max(stress_max, m.initial_stress.cwiseAbs().maxCoeff());
+  if (!cracks_.empty()) {
+    out << "Largest crack face pressure: " << p_max << " Pa on crack " << crack_id << " at (" << where.x() << ", "
+        << where.y() << ") m";
+    if (p_max > 10 * std::max(stress_max, 1.0)) {
+      out << ", more than 10 x the largest in-situ stress (" << stress_max
+          << " Pa): a pressure spike from the fluid; give the fluid room (a larger fluid.mpm.virtual_opening_m or "
+             "a pre-opening), ramp the inlet more slowly, or soften the fluid (bulk_modulus_pa). ";
+    } else {
+      out << ". ";
+    }
+  }
+  out << "Otherwise lower solid.mpm.cfl or time.safety_factor, or check the boundary conditions and loads.";
+  return out.str();
 }
 
 Voigt Solver::total_stress(std::size_t p) const {

@@ -15,6 +15,7 @@
 #include <array>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "hfmpm/solid/mpm/config.hpp"
@@ -129,6 +130,7 @@ class Solver {
   void contact(double dt);
 
   TipResult evaluate_tip(std::size_t c, bool at_end) const;
+  std::string runaway_report(std::size_t p, double dt) const;
   void update_feedback(double dt);
 
   SolidConfig config_;

@@ -1,0 +1,129 @@
+// Stability under stress, CI size (ctest label `stability`; docs/stability.md).
+//
+// scenarios/stability-kgd.scene (a small coupled KGD fracture: 1.05 m x 2.1 m box,
+// h = 0.035 m, notch 0.15 m, 1.5 s) with one input pushed to an extreme but valid
+// value per run. Every run must end normally and stay sane:
+// - no NaN or Inf in any history column;
+// - the kinetic energy stays below 1e-2 of the work the inlet pressure has done
+//   once the 0.05 s ramp is over (quasi-static loading; measured below 1e-3);
+// - the inlet pressure is never negative;
+// - the fluid's mass: the injected volume equals the integral of the ramped
+//   inlet rate (to the trapezoid error of the substep holding the ramp's kink),
+//   and the fluid's volume (sum of l w) stays above half the volume it would
+//   have at zero pressure (injected plus initial): the Tait compression at
+//   these pressures is below 10% for K >= 1 MPa. (No upper bound: particles
+//   stretched at zero pressure, J > 1, count empty space; measured up to 2.7x
+//   without confinement. Each particle's mass is constant and merging adds
+//   masses, so the mass itself is conserved by construction.)
+// Inputs that do blow up must stop the run within a few steps, exit non-zero,
+// name the runaway particle and the pressure spike with what to change, and
+// leave their output readable: a flow-rate inlet into a 10 nm film, and a
+// water-stiff fluid (K = 2 GPa), which runs away at 0.034 s (docs/stability.md).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "coupled_support.hpp"
+
+namespace hfmpm::test {
+namespace {
+
+struct Case {
+  const char* name;
+  std::vector<std::string> sets;
+  double initial_volume;  // m^2 of fluid at t = 0 (film x notch), at zero pressure to within the Tait compression
+};
+
+constexpr double kQ = 1.25e-4, kRamp = 0.05;
+
+double ramp_volume(double t) { return t >= kRamp ? kQ * (t - 0.5 * kRamp) : 0.5 * kQ * t * t / kRamp; }
+
+void expect_sane(const Case& c) {
+  const auto out = scratch_dir(std::string("stability_") + c.name);
+  std::vector<std::string> argv = {bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out,
+                                   "--quiet", "--set", "output.hdf5=false"};
+  for (const auto& s : c.sets) {
+    argv.push_back("--set");
+    argv.push_back(s);
+  }
+  const auto result = run(argv, 600);
+  ASSERT_EQ(result.exit_code, 0) << c.name << ": " << result.err;
+  const Csv h = read_csv(out + "/history.csv");
+  const auto t = h.values("time_s"), p_in = h.values("inlet_pressure_pa"), injected = h.values("injected_volume_m2"),
+             volume = h.values("fluid_volume_m2"), ke = h.values("kinetic_energy_j"), dt = h.values("dt_s");
+  ASSERT_GE(t.size(), 10u) << c.name;
+  for (const auto& row : h.rows) {
+    for (std::size_t k = 0; k < row.size(); ++k) ASSERT_TRUE(std::isfinite(row[k])) << c.name << ": " << h.header[k];
+  }
+  const double dt_max = *std::max_element(dt.begin(), dt.end());
+  double work = 0, ke_ratio = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    EXPECT_GE(p_in[i], 0) << c.name << " at t = " << t[i];
+    EXPECT_NEAR(injected[i], ramp_volume(t[i]), kQ / kRamp * dt_max * dt_max / 8 + 1e-9 * kQ)
+        << c.name << " at t = " << t[i];
+    const double zero_pressure = injected[i] + c.initial_volume;
+    EXPECT_GT(volume[i], 0.5 * zero_pressure) << c.name << " at t = " << t[i];
+    if (i > 0) work += 0.5 * (p_in[i] + p_in[i - 1]) * (injected[i] - injected[i - 1]);
+    if (t[i] > 2 * kRamp) {
+      EXPECT_LT(ke[i], 1e-2 * work) << c.name << " at t = " << t[i];
+      ke_ratio = std::max(ke_ratio, ke[i] / work);
+    }
+  }
+  std::printf("%s: %zu rows to t = %.2f s, inlet pressure %.0f Pa, fluid volume / zero-pressure volume %.3f, "
+              "max kinetic energy / inlet work %.1e\n",
+              c.name, t.size(), t.back(), p_in.back(), volume.back() / (injected.back() + c.initial_volume), ke_ratio);
+}
+
+constexpr double kFilm = 2e-5 * 0.15;  // the scene's virtual opening x notch
+
+TEST(Stability, BaseScene) { expect_sane({"base", {}, kFilm}); }
+TEST(Stability, SoftFluid) { expect_sane({"bulk_1MPa", {"fluid.mpm.bulk_modulus_pa=1e6"}, kFilm}); }
+TEST(Stability, ThinFluid) { expect_sane({"mu_1e-4", {"fluid.mpm.viscosity_pa_s=1e-4"}, kFilm}); }
+TEST(Stability, ThickFluid) { expect_sane({"mu_1", {"fluid.mpm.viscosity_pa_s=1"}, kFilm}); }
+TEST(Stability, LargePreOpening) { expect_sane({"film_1mm", {"fluid.mpm.virtual_opening_m=1e-3"}, 1e-3 * 0.15}); }
+TEST(Stability, NoConfinement) {
+  expect_sane({"unconfined",
+               {"solid.mpm.regions=[{material: \"rock\" rectangle { x_min_m: 0 y_min_m: -1.05 x_max_m: 1.05 y_max_m: 1.05 }}]",
+                "solid.mpm.tractions=[]", "fluid.mpm.initial_fill.pressure_pa=0", "fluid.mpm.lag_pressure_pa=0"},
+               kFilm});
+}
+TEST(Stability, TenTimesTheEndTime) { expect_sane({"long", {"time.end_s=15"}, kFilm}); }
+
+// A flow-rate inlet into a 10 nm film (the fluid's pressure spikes to 10 GPa
+// in the first steps) and a water-stiff fluid (2 GPa: the coupling's
+// explicit pressure outruns the implicit face stiffness; open). The solid
+// must stop the run at the first particle that moves more than a cell in a
+// step, say which and where, name the face pressure and what to change, and
+// keep the output.
+void expect_runaway_diagnosed(const char* name, const std::string& set) {
+  const auto out = scratch_dir(std::string("stability_") + name);
+  const auto result = run({bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out, "--quiet",
+                           "--set", set},
+                          300);
+  EXPECT_NE(result.exit_code, 0);
+  for (const char* part : {"ran away at step", "particle", "cells in one step", "Largest crack face pressure",
+                           "virtual_opening_m", "solid.mpm.cfl"}) {
+    EXPECT_NE(result.err.find(part), std::string::npos) << part << " not in: " << result.err;
+  }
+  const Csv h = read_csv(out + "/history.csv");  // readable, with the rows written before the failure
+  EXPECT_GE(h.values("time_s").size(), 1u);
+  const std::string manifest = read_file(out + "/run.json");
+  EXPECT_NE(manifest.find("\"status\": \"failed\""), std::string::npos) << manifest;
+  const auto steps = manifest.find("failed at step ");
+  ASSERT_NE(steps, std::string::npos);
+  EXPECT_LT(std::stoi(manifest.substr(steps + 15)), 100) << "detected late";
+}
+
+TEST(Stability, PressureSpikeStopsTheRunWithADiagnosis) {
+  expect_runaway_diagnosed("spike", "fluid.mpm.virtual_opening_m=1e-8");
+}
+TEST(Stability, WaterStiffFluidStopsTheRunWithADiagnosis) {
+  expect_runaway_diagnosed("bulk_2GPa", "fluid.mpm.bulk_modulus_pa=2e9");
+}
+
+}  // namespace
+}  // namespace hfmpm::test
