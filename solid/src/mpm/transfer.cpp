@@ -1,0 +1,279 @@
+// Particle-grid transfers of the MPM solid: P2G (mass, momentum, internal
+// force and the displacement sum into per-thread accumulators, reduced in
+// parallel) and G2P (velocities, positions, the stress update, and the check
+// that stops a run whose particles run away), with the buffers they use.
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "hfmpm/solid/mpm/shape.hpp"
+#include "hfmpm/solid/mpm/solver.hpp"
+
+namespace hfmpm::solid::mpm {
+
+template <bool kCracks>
+void Solver::p2g() {
+  const auto& g = config_.grid;
+  const auto threads = thread_acc_.size();
+  const std::size_t count = particles_.size();
+  constexpr std::size_t F = kCracks ? 2 : 1;  // fields per node in the accumulators
+  const std::size_t row = static_cast<std::size_t>(g.nodes_x());
+  const std::uint32_t epoch = epoch_;
+  if constexpr (kCracks) {
+    if (sides_.size() != count) sides_.assign(count, 0);
+  }
+#pragma omp parallel num_threads(static_cast<int>(threads))
+  {
+    const auto k = static_cast<std::size_t>(omp_get_thread_num());
+    auto& acc = thread_acc_[k];
+    const std::size_t begin = count * k / threads;
+    const std::size_t end = count * (k + 1) / threads;
+    // The rows of nodes this thread's particles reach (particles are stored
+    // row by row, so each thread's span is a band of the grid): zero them.
+    double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
+    for (std::size_t p = begin; p < end; ++p) {
+      y_lo = std::min(y_lo, particles_.x[p].y());
+      y_hi = std::max(y_hi, particles_.x[p].y());
+    }
+    std::array<std::size_t, 2> span{0, 0};
+    if (begin < end) {
+      const auto row_of = [&](double y) { return static_cast<int>(std::floor((y - g.origin.y()) / g.h + 0.5)); };
+      // One row more each way than the stencil's reach, against rounding.
+      const int j0 = std::clamp(row_of(y_lo) - 2, 0, g.ny);
+      const int j1 = std::clamp(row_of(y_hi) + 2, 0, g.ny);
+      span = {static_cast<std::size_t>(j0) * row, static_cast<std::size_t>(j1 + 1) * row};
+      std::fill(acc.begin() + static_cast<std::ptrdiff_t>(span[0] * F),
+                acc.begin() + static_cast<std::ptrdiff_t>(span[1] * F), NodeAcc{});
+    }
+    thread_span_[k] = span;
+    for (std::size_t p = begin; p < end; ++p) {
+      const Vec2 x = particles_.x[p];
+      const Vec2 rel = x - g.origin;
+      const double lp = particles_.half_size[p];
+      const auto sx = ugimp_stencil(rel.x(), g.h, lp);
+      const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+      const double m = particles_.mass[p];
+      const Vec2 mv = m * particles_.v[p];
+      const Voigt& s = particles_.stress[p];
+      const double vol = particles_.volume[p];
+      bool near = false;
+      std::uint16_t sides = 0;
+      Vec2 mu = Vec2::Zero();
+      if constexpr (kCracks) {
+        near = near_crack(x);
+        if (near) sides = 1u << 15;
+        mu = m * particles_.displacement[p];
+      }
+      for (int b = 0; b < 3; ++b) {
+        const int j = sy.first + b;
+        if (j < 0 || j > g.ny) continue;
+        const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
+        for (int a = 0; a < 3; ++a) {
+          const int i = sx.first + a;
+          if (i < 0 || i > g.nx) continue;
+          const double w = sx.s[static_cast<std::size_t>(a)] * syb;
+          if (w == 0) continue;
+          const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
+          const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
+          const auto n = static_cast<std::size_t>(g.node(i, j));
+          std::size_t slot = n * F;
+          if constexpr (kCracks) {
+            if (near && field_of(x, g.position(static_cast<int>(n)))) {
+              ++slot;
+              sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
+            }
+          }
+          NodeAcc& f = acc[slot];
+          f.m += w * m;
+          f.px += w * mv.x();
+          f.py += w * mv.y();
+          // internal force -V sigma . grad S (s = xx, yy, xy, zz)
+          f.fx -= vol * (s[0] * gx + s[2] * gy);
+          f.fy -= vol * (s[2] * gx + s[1] * gy);
+          if constexpr (kCracks) {
+            f.ux += w * mu.x();
+            f.uy += w * mu.y();
+          }
+        }
+      }
+      if constexpr (kCracks) sides_[p] = sides;
+    }
+#pragma omp barrier
+    // Reduce the spans into the fields: each thread a slice of the nodes.
+    std::size_t lo = std::numeric_limits<std::size_t>::max(), hi = 0;
+    for (const auto& sp : thread_span_) {
+      if (sp[0] < sp[1]) {
+        lo = std::min(lo, sp[0]);
+        hi = std::max(hi, sp[1]);
+      }
+    }
+    auto& active = thread_active_[k];
+    active.clear();
+    if (lo < hi) {
+      const std::size_t first = lo + (hi - lo) * k / threads, last = lo + (hi - lo) * (k + 1) / threads;
+      for (std::size_t u = first; u < last; ++u) {
+        NodeAcc sum[F] = {};
+        for (std::size_t t = 0; t < threads; ++t) {
+          const auto& sp = thread_span_[t];
+          if (u < sp[0] || u >= sp[1]) continue;
+          for (std::size_t f = 0; f < F; ++f) {
+            const NodeAcc& from = thread_acc_[t][u * F + f];
+            sum[f].m += from.m;
+            sum[f].px += from.px;
+            sum[f].py += from.py;
+            sum[f].fx += from.fx;
+            sum[f].fy += from.fy;
+            sum[f].ux += from.ux;
+            sum[f].uy += from.uy;
+          }
+        }
+        bool touched = sum[0].m > 0;
+        if constexpr (kCracks) touched = touched || sum[1].m > 0;
+        if (!touched) continue;
+        stamp_[u] = epoch;
+        active.push_back(static_cast<int>(u));
+        for (std::size_t f = 0; f < F; ++f) {
+          NodalFields& to = f ? second_ : nodes_;
+          to.mass[u] = sum[f].m;
+          to.momentum[u] = Vec2(sum[f].px, sum[f].py);
+          to.force[u] = Vec2(sum[f].fx, sum[f].fy);
+          if constexpr (kCracks) to.displaced[u] = Vec2(sum[f].ux, sum[f].uy);
+        }
+      }
+    }
+  }
+  active_.clear();
+  for (const auto& part : thread_active_) active_.insert(active_.end(), part.begin(), part.end());
+}
+
+template <bool kCracks>
+void Solver::g2p(double dt) {
+  const auto& g = config_.grid;
+  const double pic = config_.damping.pic_fraction;
+  const Vec2 lo = g.origin, hi = g.origin + g.h * Vec2(g.nx, g.ny);
+  const auto count = static_cast<std::int64_t>(particles_.size());
+  std::int64_t escaped = -1;
+  const double runaway = g.h;  // m per step
+#pragma omp parallel for num_threads(static_cast<int>(thread_acc_.size())) schedule(static)
+  for (std::int64_t q = 0; q < count; ++q) {
+    const auto p = static_cast<std::size_t>(q);
+    const Vec2 rel = particles_.x[p] - g.origin;
+    const double lp = particles_.half_size[p];
+    const auto sx = ugimp_stencil(rel.x(), g.h, lp);
+    const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+    std::uint16_t sides = 0;
+    if constexpr (kCracks) sides = sides_[p];  // the fields P2G found for its nodes
+    Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
+    double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
+    for (int b = 0; b < 3; ++b) {
+      const int j = sy.first + b;
+      if (j < 0 || j > g.ny) continue;
+      for (int c = 0; c < 3; ++c) {
+        const int i = sx.first + c;
+        if (i < 0 || i > g.nx) continue;
+        const double w = sx.s[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
+        if (w == 0) continue;
+        const double gx = sx.g[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
+        const double gy = sx.s[static_cast<std::size_t>(c)] * sy.g[static_cast<std::size_t>(b)];
+        const auto n = static_cast<std::size_t>(g.node(i, j));
+        const int field = (sides >> (3 * b + c)) & 1;
+        const Vec2& vn = velocity_[field][n];
+        v_new += w * vn;
+        a += w * acceleration_[field][n];
+        l00 += vn.x() * gx;
+        l01 += vn.x() * gy;
+        l10 += vn.y() * gx;
+        l11 += vn.y() * gy;
+      }
+    }
+    particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
+    particles_.x[p] += dt * v_new;
+    if constexpr (kCracks) {
+      particles_.displacement[p] += dt * v_new;
+      auto& gu = particles_.grad_u[p];
+      gu(0, 0) += dt * l00;
+      gu(0, 1) += dt * l01;
+      gu(1, 0) += dt * l10;
+      gu(1, 1) += dt * l11;
+    }
+    // Small-strain elastic update, plane strain (eps_zz = 0).
+    const double dxx = l00 * dt, dyy = l11 * dt, dxy = 0.5 * (l01 + l10) * dt;
+    const auto m = static_cast<std::size_t>(particles_.material[p]);
+    const double lam = lambda_[m], mu = shear_[m];
+    const double tr = dxx + dyy;
+    particles_.stress[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
+    const Vec2& x = particles_.x[p];
+    // A particle that leaves the grid, becomes NaN, or moves more than a
+    // cell in one step (|v| > 2 c_p at the largest valid CFL factor; the
+    // shape functions cannot follow that) has run away.
+    if (!(x.x() >= lo.x() && x.y() >= lo.y() && x.x() <= hi.x() && x.y() <= hi.y()) ||
+        !(dt * v_new.norm() <= runaway)) {
+#pragma omp critical
+      escaped = q;
+    }
+  }
+  if (escaped >= 0) throw std::runtime_error(runaway_report(static_cast<std::size_t>(escaped), dt));
+}
+
+// What a run that blew up needs to be told: which particle, where, how fast,
+// and the loads that can drive it, with what to change.
+std::string Solver::runaway_report(std::size_t p, double dt) const {
+  const auto& g = config_.grid;
+  std::ostringstream out;
+  out << "the solid ran away at step " << steps_ + 1 << " (t = " << t_ + dt << " s): particle " << p << " at x = ("
+      << particles_.x[p].x() << ", " << particles_.x[p].y() << ") m moved at v = (" << particles_.v[p].x() << ", "
+      << particles_.v[p].y() << ") m/s, " << dt * particles_.v[p].norm() / g.h
+      << " cells in one step (the limit is 1; NaN or off the grid counts too). ";
+  // The largest crack face pressure: a fluid pressure spike (a flow-rate
+  // inlet into a film too thin to carry it) shows here.
+  double p_max = 0;
+  Vec2 where = Vec2::Zero();
+  std::uint32_t crack_id = 0;
+  for (const auto& crack : cracks_) {
+    for (std::size_t k = 0; k < crack.size(); ++k) {
+      if (crack.face_pressure(k) > p_max) {
+        p_max = crack.face_pressure(k);
+        where = crack.plane()[k];
+        crack_id = crack.id();
+      }
+    }
+  }
+  double stress_max = 0;
+  for (const auto& m : config_.regions) stress_max = std::max(stress_max, m.initial_stress.cwiseAbs().maxCoeff());
+  if (!cracks_.empty()) {
+    out << "Largest crack face pressure: " << p_max << " Pa on crack " << crack_id << " at (" << where.x() << ", "
+        << where.y() << ") m";
+    if (p_max > 10 * std::max(stress_max, 1.0)) {
+      out << ", more than 10 x the largest in-situ stress (" << stress_max
+          << " Pa): a pressure spike from the fluid; give the fluid room (a larger fluid.mpm.virtual_opening_m or "
+             "a pre-opening), ramp the inlet more slowly, or soften the fluid (bulk_modulus_pa). ";
+    } else {
+      out << ". ";
+    }
+  }
+  out << "Otherwise lower solid.mpm.cfl or time.safety_factor, or check the boundary conditions and loads.";
+  return out.str();
+}
+
+
+std::size_t Solver::grid_bytes() const {
+  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  auto fields = [&](const NodalFields& f) {
+    return bytes(f.mass) + bytes(f.momentum) + bytes(f.force) + bytes(f.displaced) + bytes(f.fixed);
+  };
+  std::size_t total = fields(nodes_) + fields(second_) + bytes(stamp_) + bytes(active_);
+  for (int f = 0; f < 2; ++f) total += bytes(velocity_[f]) + bytes(acceleration_[f]);
+  for (const auto& acc : thread_acc_) total += bytes(acc);
+  return total;
+}
+
+template void Solver::p2g<false>();
+template void Solver::p2g<true>();
+template void Solver::g2p<false>(double);
+template void Solver::g2p<true>(double);
+
+}  // namespace hfmpm::solid::mpm
