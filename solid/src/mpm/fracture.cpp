@@ -267,7 +267,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
     const Vec2 n_up(-t.y(), t.x());
     Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
     const Voigt s0 = in_situ_stress(mid);
-    load += Vec2(s0[0] * n_up.x() + s0[2] * n_up.y(), s0[2] * n_up.x() + s0[1] * n_up.y());
+    load += traction(s0, n_up);
     j_faces -= q * load.dot(jump(b) - jump(a));
     const double step = aux_jump(b) - aux_jump(a);
     m1_faces -= q * load.dot(e2) * step;

@@ -235,7 +235,7 @@ void Solver::edge_loads() {
       const Vec2 n = outward_normal(edge);
       for (std::uint32_t p : edges_[static_cast<std::size_t>(edge)]) {
         const Voigt& s0 = config_.regions[static_cast<std::size_t>(particles_.region[p])].initial_stress;
-        const Vec2 t0(s0[0] * n.x() + s0[2] * n.y(), s0[2] * n.x() + s0[1] * n.y());
+        const Vec2 t0 = traction(s0, n);
         if (t0.squaredNorm() > 0) spread(p, n, -t0 * 2 * particles_.half_size[p]);
       }
     }

@@ -98,13 +98,10 @@ void Solver::crack_loads() {
       // Pressure opens the crack: +n into the field above, -n into the field
       // below. With the in-situ stress as reference the faces also give up
       // the in-situ traction sigma0 n that the uncut body carried across them.
-      Vec2 traction = p * n;
-      if (config_.in_situ_reference) {
-        const Voigt s0 = in_situ_stress(crack.plane()[k]);
-        traction += Vec2(s0[0] * n.x() + s0[2] * n.y(), s0[2] * n.x() + s0[1] * n.y());
-      }
-      if (traction.squaredNorm() == 0) continue;
-      const Vec2 force = crack.tributary_length(k) * traction;
+      Vec2 t = p * n;
+      if (config_.in_situ_reference) t += traction(in_situ_stress(crack.plane()[k]), n);
+      if (t.squaredNorm() == 0) continue;
+      const Vec2 force = crack.tributary_length(k) * t;
       for (int side : {1, -1}) {
         for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
           (f ? second_ : nodes_).force[static_cast<std::size_t>(nd)] += side * w * force;

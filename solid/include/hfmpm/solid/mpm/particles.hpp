@@ -12,6 +12,11 @@ namespace hfmpm::solid::mpm {
 // Stress in plane strain as (xx, yy, xy, zz); tension positive.
 using Voigt = Eigen::Vector4d;
 
+// The traction sigma n of a plane-strain stress on a plane with unit normal n.
+inline Vec2 traction(const Voigt& s, const Vec2& n) {
+  return {s[0] * n.x() + s[2] * n.y(), s[2] * n.x() + s[1] * n.y()};
+}
+
 struct Particles {
   std::vector<Vec2> x;            // m, position
   std::vector<Vec2> v;            // m/s, velocity
