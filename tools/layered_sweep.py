@@ -1,0 +1,200 @@
+#!/usr/bin/python3
+"""Layered-medium sweep: fracture paths beside a stiff/soft interface, by viscosity and starting layer.
+
+    /usr/bin/python3 tools/layered_sweep.py [--out hfmpm-out/layered] [--viscosities 1e-4,1e-3,1e-2]
+        [--starts stiff,soft] [--ci] [--bin build/release/bin] [--force] [--set KEY=VALUE ...]
+
+Runs scenarios/layered.scene once per (starting layer, viscosity). The scene starts the crack
+in the stiff layer; the soft start swaps the two layers' materials (the same geometry, so the
+crack lies in the soft layer at the same distance from the interface). `--ci` runs the scene's
+CI size (scenarios/layered-ci.scene). A finished run (run.json "completed") is reused unless
+--force. Writes OUT/paths.png (the crack paths over the layers, one panel per starting layer),
+OUT/summary.csv, and prints a table: how far each crack grew, its deviation toward the other
+layer at the end and at a common length, the tip's angle, and whether it propagated at all.
+
+Deviation: the crack's offset from its starting line, signed positive toward the interface
+(the other layer). Measured at the tip at the end, and at x = the shortest propagated run's
+reach (so runs of different lengths compare at one place).
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+
+def layers_of(scene_text):
+    """The scene's layer regions: [(material, y_min, y_max)] and materials' moduli {name: E}."""
+    mats = {m.group(1): float(m.group(2)) for m in
+            re.finditer(r'materials\s*\{\s*name:\s*"([^"]+)"\s*youngs_modulus_pa:\s*([0-9.eE+-]+)', scene_text)}
+    num = r"([0-9.eE+-]+)"
+    layers = [(m.group(1), float(m.group(3)), float(m.group(5)), float(m.group(2)), float(m.group(4))) for m in
+              re.finditer(r'regions\s*\{\s*material:\s*"([^"]+)"\s*rectangle\s*\{\s*x_min_m:\s*' + num +
+                          r'\s*y_min_m:\s*' + num + r'\s*x_max_m:\s*' + num + r'\s*y_max_m:\s*' + num, scene_text)]
+    crack = re.search(r'cracks\s*\{\s*x_m:\s*\[([^\]]+)\]\s*y_m:\s*\[([^\]]+)\]', scene_text)
+    if len(layers) != 2 or len(mats) != 2 or not crack:
+        sys.exit("layered_sweep: the scene must have two materials, two rectangle regions (the layers, one above the other) and one crack "
+                 "written as in scenarios/layered.scene")
+    xs = [float(v) for v in crack.group(1).split(",")]
+    ys = [float(v) for v in crack.group(2).split(",")]
+    return layers, mats, (xs, ys)
+
+
+def run_case(a, scene, out, sets):
+    done = os.path.join(out, "run.json")
+    if not a.force and os.path.exists(done):
+        try:
+            with open(done) as f:
+                if json.load(f).get("status") == "completed":
+                    return "reused"
+        except (OSError, ValueError):
+            pass
+    cmd = [os.path.join(a.bin, "hfmpm"), "run", scene, "--out", out, "--quiet"]
+    for s in sets:
+        cmd += ["--set", s]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        print(f"layered_sweep: {out}: run failed (exit {r.returncode}): {r.stderr.strip()[-400:]}", file=sys.stderr)
+        return "failed"
+    return "ran"
+
+
+def final_path(out):
+    import h5py
+    with h5py.File(os.path.join(out, "solid.h5"), "r") as f:
+        frames = f["frames"]
+        last = frames[sorted(frames.keys())[-1]]
+        pos = last["crack0/positions"][:]
+        return [float(p[0]) for p in pos], [float(p[1]) for p in pos]
+
+
+def y_at(xs, ys, x):
+    """The path's y where it first reaches x (linear between crack particles); None if it does not."""
+    for i in range(1, len(xs)):
+        if xs[i - 1] <= x <= xs[i] and xs[i] > xs[i - 1]:
+            f = (x - xs[i - 1]) / (xs[i] - xs[i - 1])
+            return ys[i - 1] + f * (ys[i] - ys[i - 1])
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", default=os.path.join(ROOT, "hfmpm-out", "layered"))
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
+    ap.add_argument("--viscosities", default="1e-4,1e-3,1e-2", help="Pa s, comma-separated")
+    ap.add_argument("--starts", default="stiff,soft", help="starting layers: stiff, soft or both")
+    ap.add_argument("--ci", action="store_true", help="the CI size (scenarios/layered-ci.scene)")
+    ap.add_argument("--force", action="store_true", help="rerun finished runs")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="passed to every run")
+    a = ap.parse_args()
+    try:
+        mus = [float(v) for v in a.viscosities.split(",")]
+    except ValueError:
+        sys.exit(f"layered_sweep: --viscosities '{a.viscosities}': give numbers in Pa s separated by commas")
+    if not mus or any(not (m > 0) for m in mus):
+        sys.exit("layered_sweep: --viscosities: each must be > 0 (Pa s)")
+    starts = a.starts.split(",")
+    for s in starts:
+        if s not in ("stiff", "soft"):
+            sys.exit(f"layered_sweep: --starts: '{s}' is not a layer; allowed: stiff, soft")
+    if not os.path.exists(os.path.join(a.bin, "hfmpm")):
+        sys.exit(f"layered_sweep: no hfmpm in --bin {a.bin} (build first: cmake --build build/release)")
+    scene = os.path.join(ROOT, "scenarios", "layered-ci.scene" if a.ci else "layered.scene")
+    with open(scene) as f:
+        text = f.read()
+    layers, mats, (cx, cy) = layers_of(text)
+    stiff = max(mats, key=mats.get)
+    soft = min(mats, key=mats.get)
+    y0 = cy[0]
+    # The layer the scene's crack starts in, and the interface between the layers.
+    start_layer = next(m for m, lo, hi, _, _ in layers if lo <= y0 <= hi)
+    if start_layer != stiff:
+        sys.exit(f"layered_sweep: {scene}: the crack must start in the stiff layer ('{stiff}'); the soft start "
+                 "is made by swapping the layers")
+    interface = layers[0][2] if abs(layers[0][2] - layers[1][1]) < 1e-9 else None
+    if interface is None:
+        sys.exit(f"layered_sweep: {scene}: the two layers must share an edge")
+    toward = 1.0 if interface > y0 else -1.0
+    stress = re.search(r"initial_stress\s*\{[^}]*\}", text)
+    stress_text = stress.group(0) if stress else ""
+    os.makedirs(a.out, exist_ok=True)
+
+    rows = []
+    for start in starts:
+        sets = list(a.set)
+        if start == "soft":
+            regs = ", ".join(f'{{material: "{soft if m == stiff else stiff}" rectangle {{x_min_m: {x0:g} y_min_m: {lo:g} '
+                             f'x_max_m: {x1:g} y_max_m: {hi:g}}} {stress_text}}}' for m, lo, hi, x0, x1 in layers)
+            sets.append(f"solid.mpm.regions=[{regs}]")
+        for mu in mus:
+            out = os.path.join(a.out, f"{start}_mu{mu:g}")
+            status = run_case(a, scene, out, sets + [f"fluid.mpm.viscosity_pa_s={mu:g}"])
+            row = {"start": start, "viscosity_pa_s": mu, "out": out, "status": status}
+            if status != "failed":
+                xs, ys = final_path(out)
+                row.update(path=(xs, ys), reach_m=xs[-1], tip_y_m=ys[-1],
+                           deviation_m=toward * (ys[-1] - y0),
+                           tip_angle_deg=math.degrees(math.atan2(toward * (ys[-1] - ys[-2]), xs[-1] - xs[-2])),
+                           propagated=xs[-1] > cx[-1] + 1e-6)
+            rows.append(row)
+    grown = [r for r in rows if r.get("propagated")]
+    x_common = min(r["reach_m"] for r in grown) if grown else None
+    for r in rows:
+        if r.get("propagated") and x_common is not None:
+            yc = y_at(*r["path"], x_common)
+            r["deviation_at_common_m"] = toward * (yc - y0) if yc is not None else float("nan")
+
+    print(f"| start | viscosity (Pa s) | grew to x (m) | deviation at the tip (m) | "
+          f"deviation at x = {x_common if x_common else float('nan'):.2f} m | tip angle (deg) | propagated |")
+    print("|---|---|---|---|---|---|---|")
+    for r in rows:
+        if r["status"] == "failed":
+            print(f"| {r['start']} | {r['viscosity_pa_s']:g} | run failed | | | | |")
+            continue
+        print(f"| {r['start']} | {r['viscosity_pa_s']:g} | {r['reach_m']:.2f} | {r['deviation_m']:+.3f} | "
+              f"{r.get('deviation_at_common_m', float('nan')):+.3f} | {r['tip_angle_deg']:+.1f} | "
+              f"{'yes' if r['propagated'] else 'no'} |")
+    print("deviation > 0: toward the other layer (the interface)")
+    with open(os.path.join(a.out, "summary.csv"), "w", newline="") as f:
+        keys = ["start", "viscosity_pa_s", "status", "reach_m", "tip_y_m", "deviation_m", "deviation_at_common_m",
+                "tip_angle_deg", "propagated"]
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(starts), figsize=(6.5 * len(starts), 5), squeeze=False)
+    xmax = max([r["reach_m"] for r in rows if "reach_m" in r] + [cx[-1]]) + 2
+    for ax, start in zip(axes[0], starts):
+        for m, lo, hi, _, _ in layers:
+            mat = m if start == "stiff" else (soft if m == stiff else stiff)
+            ax.axhspan(max(lo, y0 - 8), min(hi, y0 + 8), color="0.75" if mat == stiff else "0.93", zorder=0)
+            ax.text(0.3, (max(lo, y0 - 8) + min(hi, y0 + 8)) / 2, f"{mat}: E = {mats[mat]:.3g} Pa",
+                    fontsize=8, va="center")
+        ax.axhline(interface, color="k", lw=0.8)
+        for r in rows:
+            if r["start"] == start and "path" in r:
+                ax.plot(*r["path"], ".-", ms=3, label=f"mu = {r['viscosity_pa_s']:g} Pa s"
+                        + ("" if r["propagated"] else " (did not grow)"))
+        ax.plot(cx, cy, "k-", lw=3, label="initial crack")
+        ax.set(xlim=(0, xmax), ylim=(y0 - 8, y0 + 8), xlabel="x (m)", ylabel="y (m)",
+               title=f"started in the {start} layer")
+        ax.set_aspect("equal")
+        ax.legend(fontsize=7, loc="lower right")
+    fig.suptitle("Fluid-driven crack beside a stiff/soft interface (scenarios/layered.scene)")
+    fig.tight_layout()
+    png = os.path.join(a.out, "paths.png")
+    fig.savefig(png, dpi=110)
+    print(f"layered_sweep: wrote {png}")
+
+
+if __name__ == "__main__":
+    main()
