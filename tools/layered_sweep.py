@@ -7,14 +7,16 @@
 Runs scenarios/layered.scene once per (starting layer, viscosity). The scene starts the crack
 in the stiff layer; the soft start swaps the two layers' materials (the same geometry, so the
 crack lies in the soft layer at the same distance from the interface). `--ci` runs the scene's
-CI size (scenarios/layered-ci.scene). A finished run (run.json "completed") is reused unless
---force. Writes OUT/paths.png (the crack paths over the layers, one panel per starting layer),
-OUT/summary.csv, and prints a table: how far each crack grew, its deviation toward the other
-layer at the end and at a common length, the tip's angle, and whether it propagated at all.
+CI size (scenarios/layered-ci.scene). A finished run with the same scene file and settings is
+reused (tools/kgd_sweep.py's run helper), unless --force (use it after a rebuild). Writes
+OUT/paths.png (the crack paths over the layers, one panel per starting layer), OUT/summary.csv,
+and prints a table: how far each crack grew, its deviation toward the other layer at the end
+and at a common reach, its mean offset, and whether it propagated.
 
 Deviation: the crack's offset from its starting line, signed positive toward the interface
-(the other layer). Measured at the tip at the end, and at x = the shortest propagated run's
-reach (so runs of different lengths compare at one place), and as the mean offset of the
+(the other layer). Measured at the tip at the end, and at x = the shortest propagated reach
+among the runs from the same layer (so runs of different lengths compare at one place), and
+as the mean offset of the
 path between the notch's tip and that x. A run "propagated" when its crack grew more than
 two cells: the zero-lag closure lets a tip grow up to about a cell ahead of the fluid front,
 and with J_Ic = 5 J/m^2 the start's transient does that (and may kink it once) even where
@@ -22,19 +24,17 @@ no fluid follows.
 """
 import argparse
 import csv
-import json
-import math
 import os
 import re
-import subprocess
+import signal
 import sys
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from kgd_sweep import ROOT, die, hfmpm_path, on_sigterm, run_case, stop_all  # noqa: E402
 
 
 def layers_of(scene_text):
-    """The scene's layer regions: [(material, y_min, y_max)] and materials' moduli {name: E}."""
+    """The scene's layers [(material, y_min, y_max, x_min, x_max)], moduli {name: E} and crack polyline."""
     mats = {m.group(1): float(m.group(2)) for m in
             re.finditer(r'materials\s*\{\s*name:\s*"([^"]+)"\s*youngs_modulus_pa:\s*([0-9.eE+-]+)', scene_text)}
     num = r"([0-9.eE+-]+)"
@@ -43,30 +43,11 @@ def layers_of(scene_text):
                           r'\s*y_min_m:\s*' + num + r'\s*x_max_m:\s*' + num + r'\s*y_max_m:\s*' + num, scene_text)]
     crack = re.search(r'cracks\s*\{\s*x_m:\s*\[([^\]]+)\]\s*y_m:\s*\[([^\]]+)\]', scene_text)
     if len(layers) != 2 or len(mats) != 2 or not crack:
-        sys.exit("layered_sweep: the scene must have two materials, two rectangle regions (the layers, one above the other) and one crack "
-                 "written as in scenarios/layered.scene")
+        die("the scene must have two materials, two rectangle regions (the layers, one above the other) and one crack "
+            "written as in scenarios/layered.scene")
     xs = [float(v) for v in crack.group(1).split(",")]
     ys = [float(v) for v in crack.group(2).split(",")]
     return layers, mats, (xs, ys)
-
-
-def run_case(a, scene, out, sets):
-    done = os.path.join(out, "run.json")
-    if not a.force and os.path.exists(done):
-        try:
-            with open(done) as f:
-                if json.load(f).get("status") == "completed":
-                    return "reused"
-        except (OSError, ValueError):
-            pass
-    cmd = [os.path.join(a.bin, "hfmpm"), "run", scene, "--out", out, "--quiet"]
-    for s in sets:
-        cmd += ["--set", s]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        print(f"layered_sweep: {out}: run failed (exit {r.returncode}): {r.stderr.strip()[-400:]}", file=sys.stderr)
-        return "failed"
-    return "ran"
 
 
 def final_path(out):
@@ -104,21 +85,22 @@ def main():
     ap.add_argument("--viscosities", default="1e-4,1e-3,1e-2", help="Pa s, comma-separated")
     ap.add_argument("--starts", default="stiff,soft", help="starting layers: stiff, soft or both")
     ap.add_argument("--ci", action="store_true", help="the CI size (scenarios/layered-ci.scene)")
-    ap.add_argument("--force", action="store_true", help="rerun finished runs")
+    ap.add_argument("--force", action="store_true", help="rerun finished runs (after a rebuild)")
+    ap.add_argument("--timeout", type=float, default=3600, help="s per run (default 3600)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="passed to every run")
     a = ap.parse_args()
     try:
         mus = [float(v) for v in a.viscosities.split(",")]
     except ValueError:
-        sys.exit(f"layered_sweep: --viscosities '{a.viscosities}': give numbers in Pa s separated by commas")
+        die(f"--viscosities '{a.viscosities}': give numbers in Pa s separated by commas")
     if not mus or any(not (m > 0) for m in mus):
-        sys.exit("layered_sweep: --viscosities: each must be > 0 (Pa s)")
+        die("--viscosities: each must be > 0 (Pa s)")
     starts = a.starts.split(",")
     for s in starts:
         if s not in ("stiff", "soft"):
-            sys.exit(f"layered_sweep: --starts: '{s}' is not a layer; allowed: stiff, soft")
-    if not os.path.exists(os.path.join(a.bin, "hfmpm")):
-        sys.exit(f"layered_sweep: no hfmpm in --bin {a.bin} (build first: cmake --build build/release)")
+            die(f"--starts: '{s}' is not a layer; allowed: stiff, soft")
+    exe = hfmpm_path(a.bin)
+    signal.signal(signal.SIGTERM, on_sigterm)
     scene = os.path.join(ROOT, "scenarios", "layered-ci.scene" if a.ci else "layered.scene")
     with open(scene) as f:
         text = f.read()
@@ -130,11 +112,11 @@ def main():
     # The layer the scene's crack starts in, and the interface between the layers.
     start_layer = next(m for m, lo, hi, _, _ in layers if lo <= y0 <= hi)
     if start_layer != stiff:
-        sys.exit(f"layered_sweep: {scene}: the crack must start in the stiff layer ('{stiff}'); the soft start "
+        die(f"{scene}: the crack must start in the stiff layer ('{stiff}'); the soft start "
                  "is made by swapping the layers")
     interface = layers[0][2] if abs(layers[0][2] - layers[1][1]) < 1e-9 else None
     if interface is None:
-        sys.exit(f"layered_sweep: {scene}: the two layers must share an edge")
+        die(f"{scene}: the two layers must share an edge")
     toward = 1.0 if interface > y0 else -1.0
     stress = re.search(r"initial_stress\s*\{[^}]*\}", text)
     stress_text = stress.group(0) if stress else ""
@@ -149,7 +131,15 @@ def main():
             sets.append(f"solid.mpm.regions=[{regs}]")
         for mu in mus:
             out = os.path.join(a.out, f"{start}_mu{mu:g}")
-            status = run_case(a, scene, out, sets + [f"fluid.mpm.viscosity_pa_s={mu:g}"])
+            try:
+                res = run_case(exe, scene, out, sets + [f"fluid.mpm.viscosity_pa_s={mu:g}"], a.timeout, a.force)
+            except KeyboardInterrupt:
+                stop_all()
+                die("interrupted; finished runs are kept and reused next time")
+            status = "failed" if res["rc"] != 0 else ("reused" if res["reused"] else "ran")
+            if status == "failed":
+                print(f"layered_sweep: {out}: run failed (exit {res['rc']}): {res['stderr'].strip()[-400:]}",
+                      file=sys.stderr)
             row = {"start": start, "viscosity_pa_s": mu, "out": out, "status": status}
             if status != "failed":
                 xs, ys = final_path(out)
