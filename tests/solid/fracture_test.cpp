@@ -118,6 +118,34 @@ TEST(EdgeCrack, ModeIStaysSymmetric) {
 namespace hfmpm::solid::mpm {
 namespace {
 
+constexpr double kA = 1, kB = 10, kSigma = 1e6;
+
+// The centre crack of length 2 kA at 45 degrees in the plate [-kB, kB]^2 pulled by
+// kSigma on its top and bottom edges; crack particles every half cell.
+SolidConfig inclined_crack(double h) {
+  SolidConfig c;
+  c.grid.origin = Vec2(-kB - 2 * h, -kB - 2 * h);
+  c.grid.h = h;
+  c.grid.nx = c.grid.ny = static_cast<int>(std::lround(2 * kB / h)) + 4;
+  c.materials = {kRock};
+  Region r;
+  r.lo = Vec2(-kB, -kB);
+  r.hi = Vec2(kB, kB);
+  c.regions = {r};
+  const auto sigma = TimeFunction::constant(kSigma);
+  c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
+  CrackSpec crack;
+  const int segments = static_cast<int>(std::lround(4 * kA / h));
+  const Vec2 dir(std::cos(kPi / 4), std::sin(kPi / 4));
+  for (int k = 0; k <= segments; ++k) crack.points.push_back((-kA + 2 * kA * k / segments) * dir);
+  crack.start_is_tip = true;
+  crack.end_is_tip = true;
+  c.cracks = {crack};
+  c.damping.grid_alpha = critical_alpha(2 * kB);
+  c.threads = 2;
+  return c;
+}
+
 // Centre crack of length 2a at beta = 45 degrees to the x axis in a square
 // plate [-10a, 10a]^2 under remote tension sigma_yy. Reference: the infinite
 // plate (Tada, Paris and Irwin, The Stress Analysis of Cracks Handbook, 1.4;
@@ -141,29 +169,9 @@ namespace {
 // default domain to 8%, and the kink on both to 3 degrees.
 // HFMPM_INCLINED_CELLS=n runs at h = a/n.
 TEST(InclinedCrack, MixedModeAndKinkAngle) {
-  constexpr double kA = 1, kB = 10, kSigma = 1e6;
   const int cells = std::getenv("HFMPM_INCLINED_CELLS") ? std::atoi(std::getenv("HFMPM_INCLINED_CELLS")) : 5;
   const double h = kA / cells;
-  SolidConfig c;
-  c.grid.origin = Vec2(-kB - 2 * h, -kB - 2 * h);
-  c.grid.h = h;
-  c.grid.nx = c.grid.ny = static_cast<int>(std::lround(2 * kB / h)) + 4;
-  c.materials = {kRock};
-  Region r;
-  r.lo = Vec2(-kB, -kB);
-  r.hi = Vec2(kB, kB);
-  c.regions = {r};
-  const auto sigma = TimeFunction::constant(kSigma);
-  c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
-  CrackSpec crack;
-  const int segments = static_cast<int>(std::lround(4 * kA / h));  // every half cell
-  const Vec2 dir(std::cos(kPi / 4), std::sin(kPi / 4));
-  for (int k = 0; k <= segments; ++k) crack.points.push_back((-kA + 2 * kA * k / segments) * dir);
-  crack.start_is_tip = true;
-  crack.end_is_tip = true;
-  c.cracks = {crack};
-  c.damping.grid_alpha = critical_alpha(2 * kB);
-  c.threads = 2;
+  SolidConfig c = inclined_crack(h);
   Solver solid(c);
   settle(solid, 2 * kB, 12);
   const double k_exact = kSigma * std::sqrt(kPi * kA) / 2;
@@ -201,30 +209,10 @@ TEST(InclinedCrack, MixedModeAndKinkAngle) {
 // within 10 degrees of the first direction (the new tip is half a cell from
 // the singularity the domain sees, which shifts the measured K's).
 TEST(InclinedCrack, ASecondKinkDoesNotRepeatTheFirst) {
-  constexpr double kA = 1, kB = 10, kSigma = 1e6;
   const double h = kA / 5;
-  SolidConfig c;
-  c.grid.origin = Vec2(-kB - 2 * h, -kB - 2 * h);
-  c.grid.h = h;
-  c.grid.nx = c.grid.ny = static_cast<int>(std::lround(2 * kB / h)) + 4;
-  c.materials = {kRock};
-  Region r;
-  r.lo = Vec2(-kB, -kB);
-  r.hi = Vec2(kB, kB);
-  c.regions = {r};
-  const auto sigma = TimeFunction::constant(kSigma);
-  c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
-  CrackSpec crack;
-  const int segments = static_cast<int>(std::lround(4 * kA / h));
-  const Vec2 dir(std::cos(kPi / 4), std::sin(kPi / 4));
-  for (int k = 0; k <= segments; ++k) crack.points.push_back((-kA + 2 * kA * k / segments) * dir);
-  crack.start_is_tip = true;
-  crack.end_is_tip = true;
-  c.cracks = {crack};
+  SolidConfig c = inclined_crack(h);
   c.fracture.inner_cells = 3;
   c.fracture.outer_cells = 7;
-  c.damping.grid_alpha = critical_alpha(2 * kB);
-  c.threads = 2;
   Solver solid(c);
   settle(solid, 2 * kB, 12);
   auto end_tip = [&] {
