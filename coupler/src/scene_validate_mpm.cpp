@@ -128,6 +128,9 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
         c.missing(k + "shape", "one of rectangle, polygon, layer");
         break;
     }
+    if (r.has_particles_per_cell() && (r.particles_per_cell() < 1 || r.particles_per_cell() > 4)) {
+      c.bad(k + "particles_per_cell", std::to_string(r.particles_per_cell()), "1, 2, 3 or 4 (per direction)");
+    }
     if (r.has_initial_stress()) {
       const auto& s = r.initial_stress();
       for (const auto& [name, v] : {std::pair{"xx_pa", s.xx_pa()}, std::pair{"yy_pa", s.yy_pa()},

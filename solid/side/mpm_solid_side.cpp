@@ -204,6 +204,7 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
     const double nu = c.materials[static_cast<std::size_t>(region.material)].poisson_ratio;
     region.initial_stress = mpm::Voigt(st.xx_pa(), st.yy_pa(), st.xy_pa(),
                                        st.has_zz_pa() ? st.zz_pa() : nu * (st.xx_pa() + st.yy_pa()));
+    if (r.has_particles_per_cell()) region.particles_per_cell = static_cast<int>(r.particles_per_cell());
     c.regions.push_back(region);
   }
   c.particles_per_cell = static_cast<int>(s.particles_per_cell());

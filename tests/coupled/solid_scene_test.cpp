@@ -64,6 +64,9 @@ TEST(SolidScene, BadFractureSettingsAreRefused) {
       {"solid.mpm.in_situ_reference=true --set solid.mpm.regions=[{material: \"rock\" polygon { x_m: [0, 1, 0] "
        "y_m: [0, 0, 1] }}]",
        "solid.mpm.regions[0].polygon", "rectangle or layer regions"},
+      {"solid.mpm.regions=[{material: \"rock\" rectangle { x_min_m: 0 y_min_m: -1 x_max_m: 1 y_max_m: 1 } "
+       "particles_per_cell: 5}]",
+       "solid.mpm.regions[0].particles_per_cell", "1, 2, 3 or 4"},
   };
   for (const auto& c : cases) {
     std::vector<std::string> args = {bin("hfmpm"), "validate", source("scenarios/sneddon.scene")};

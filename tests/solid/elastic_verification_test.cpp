@@ -112,6 +112,42 @@ TEST(InSituStress, HeldByEqualTractionsNothingMoves) {
   for (const auto& stress : solid.particles().stress) EXPECT_NEAR(stress[0], s, 1e-6 * std::abs(s));
 }
 
+// The same with particles of two sizes: one per cell in the block and four
+// (2 x 2) in an inner rectangle whose edges do not lie on cell boundaries
+// (0.23..0.61 x 0.11..0.37 with h = 0.05). Each cell takes the finer density
+// of the regions in it, so the particles still tile the block exactly: the
+// mass is the block's to round-off, the particle count is the cells' count
+// worked out by hand, and the uniform stress is still in exact equilibrium.
+TEST(InSituStress, HeldWithParticlesOfTwoSizes) {
+  const double h = 0.05;
+  SolidConfig c = block(1.0, 0.5, h);
+  const double s = -2e6;
+  c.regions[0].initial_stress = Voigt(s, 0.5 * s, 0.0, 0.3 * 1.5 * s);
+  c.regions[0].particles_per_cell = 1;
+  Region inner = c.regions[0];
+  inner.lo = Vec2(0.23, 0.11);
+  inner.hi = Vec2(0.61, 0.37);
+  inner.particles_per_cell = 2;
+  c.regions.push_back(inner);
+  c.tractions = {{Edge::Left, TimeFunction::constant(s)},
+                 {Edge::Right, TimeFunction::constant(s)},
+                 {Edge::Bottom, TimeFunction::constant(0.5 * s)},
+                 {Edge::Top, TimeFunction::constant(0.5 * s)}};
+  Solver solid(c);
+  // Cells touched by the inner rectangle: x 0.20..0.65 (9 cells), y 0.10..0.40
+  // (6 cells): 54 cells of 4 particles, the other 200 - 54 cells of 1.
+  EXPECT_EQ(solid.particles().size(), 54u * 4 + (200u - 54u));
+  double mass = 0;
+  for (double m : solid.particles().mass) mass += m;
+  EXPECT_NEAR(mass, rock().density * 0.5, 1e-12 * rock().density * 0.5);
+  const double dt = solid.stable_dt();
+  for (int i = 0; i < 300; ++i) solid.step(dt);
+  double vmax = 0;
+  for (const auto& v : solid.particles().v) vmax = std::max(vmax, v.norm());
+  EXPECT_LT(vmax, 1e-12) << "max particle speed " << vmax << " m/s";
+  for (const auto& stress : solid.particles().stress) EXPECT_NEAR(stress[0], s, 1e-6 * std::abs(s));
+}
+
 TEST(UniaxialCompression, SettlesToTheTractionWithPlaneStrainZStress) {
   const double h = 0.05, p = 1e6;
   SolidConfig c = block(0.5, 0.5, h);

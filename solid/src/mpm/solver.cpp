@@ -69,22 +69,54 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
   min_mass_ = 1e-9 * lightest;
 }
 
+// Each cell is filled at one density: the largest particles_per_cell of the
+// regions found in it (sampled at the particle positions of every density,
+// 1 to 4 per direction), so particles of one cell never overlap and a region
+// boundary inside a cell takes the finer spacing. Each particle then takes
+// the material and stress of the region that wins at its own position.
+// Particles stay ordered by rows of cells, as the threads' node spans expect.
 void Solver::generate_particles() {
   const auto& g = config_.grid;
-  const int ppc = config_.particles_per_cell;
-  const double spacing = g.h / ppc;
+  constexpr int kMaxPpc = 4;
+  auto density_of = [&](const Region& r) {
+    return r.particles_per_cell > 0 ? r.particles_per_cell : config_.particles_per_cell;
+  };
+  auto winner = [&](const Vec2& x) -> const Region* {
+    const Region* found = nullptr;
+    for (const auto& r : config_.regions) {
+      if (r.contains(x)) found = &r;  // later regions win
+    }
+    return found;
+  };
+  bool uniform = true;
+  for (const auto& r : config_.regions) uniform = uniform && density_of(r) == config_.particles_per_cell;
+  auto cell_density = [&](int i, int j) {
+    if (uniform) return config_.particles_per_cell;
+    int best = 0;
+    for (int k = 1; k <= kMaxPpc; ++k) {
+      for (int b = 0; b < k; ++b) {
+        for (int a = 0; a < k; ++a) {
+          const Region* r = winner(g.origin + Vec2((i + (a + 0.5) / k) * g.h, (j + (b + 0.5) / k) * g.h));
+          if (r) best = std::max(best, density_of(*r));
+        }
+      }
+    }
+    return best > 0 ? best : config_.particles_per_cell;
+  };
+  std::vector<int> row_density(static_cast<std::size_t>(g.nx));
   for (int j = 0; j < g.ny; ++j) {
-    for (int b = 0; b < ppc; ++b) {
+    for (int i = 0; i < g.nx; ++i) row_density[static_cast<std::size_t>(i)] = cell_density(i, j);
+    for (int b = 0; b < kMaxPpc; ++b) {
       for (int i = 0; i < g.nx; ++i) {
+        const int ppc = row_density[static_cast<std::size_t>(i)];
+        if (b >= ppc) continue;
+        const double spacing = g.h / ppc;
+        const double volume = spacing * spacing;
         for (int a = 0; a < ppc; ++a) {
           const Vec2 x = g.origin + Vec2((i + (a + 0.5) / ppc) * g.h, (j + (b + 0.5) / ppc) * g.h);
-          const Region* found = nullptr;
-          for (const auto& r : config_.regions) {
-            if (r.contains(x)) found = &r;  // later regions win
-          }
+          const Region* found = winner(x);
           if (!found) continue;
           const auto mat = static_cast<std::size_t>(found->material);
-          const double volume = spacing * spacing;
           if (config_.in_situ_reference) {
             particles_.add(x, density_[mat] * volume, volume, spacing / 2, Voigt::Zero(), found->material);
             particles_.region.push_back(static_cast<std::int32_t>(found - config_.regions.data()));

@@ -24,6 +24,7 @@ struct Region {
   std::vector<Vec2> polygon;                   // Polygon vertices, either orientation
   int material = 0;
   Voigt initial_stress = Voigt::Zero();  // Pa, (xx, yy, xy, zz), tension positive
+  int particles_per_cell = 0;            // per direction, 1 to 4; 0: SolidConfig's
 
   bool contains(const Vec2& p) const;
 };
