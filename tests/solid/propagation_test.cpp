@@ -91,6 +91,49 @@ TEST(Propagation, TipWaitsForTheFluidFrontWithMaxLag) {
   EXPECT_EQ(solid.cracks()[0].size(), initial + 1);
 }
 
+// settle_transits: after a tip grows it waits settle_transits x L / c_s (L the
+// crack's length, c_s the shear-wave speed) before it may grow again. The
+// edge crack of the test above under 1.5 sigma_c grows at every check
+// without the wait (steps 5 apart); with settle_transits 1 the gaps between
+// growth steps are at least L / c_s and at most that plus a check interval.
+TEST(Propagation, GrownTipWaitsSettleTransitsBeforeGrowingAgain) {
+  constexpr double kW = 1, kA = 0.3, kH = 1.5 * kW, kToughness = 500;
+  const double e_prime = kRock.plane_strain_modulus();
+  const double sigma_c = std::sqrt(e_prime * kToughness) / (tada_edge_factor(kA / kW) * std::sqrt(kPi * kA));
+  auto growth_times = [&](double settle) {
+    auto config = edge_crack(kW, kA, kH, 20, TimeFunction::constant(1.5 * sigma_c));
+    config.materials[0].toughness = kToughness;
+    config.fracture.propagate = true;
+    config.fracture.check_interval = 5;
+    config.fracture.settle_transits = settle;
+    Solver solid(config);
+    const double dt = solid.stable_dt();
+    std::vector<std::pair<double, double>> grown;  // (time, crack length before)
+    std::size_t size = solid.cracks()[0].size();
+    const double transit = 2 * kH / kRock.p_wave_speed(kRock.density);
+    while (solid.time() < 6 * transit && grown.size() < 4) {
+      const double length = solid.cracks()[0].plane().back().x();
+      solid.step(dt);
+      if (solid.cracks()[0].size() > size) grown.emplace_back(solid.time(), length);
+      size = solid.cracks()[0].size();
+    }
+    return std::make_pair(grown, dt);
+  };
+  const double c_s = std::sqrt(kRock.shear_modulus() / kRock.density);
+  const auto [eager, dt] = growth_times(0);
+  ASSERT_GE(eager.size(), 3u);
+  EXPECT_NEAR(eager[2].first - eager[1].first, 5 * dt, 1e-9 * dt) << "without the wait: every check";
+  const auto [settled, dt2] = growth_times(1);
+  ASSERT_GE(settled.size(), 3u) << "the settled crack must still grow";
+  for (std::size_t k = 1; k < settled.size(); ++k) {
+    const double gap = settled[k].first - settled[k - 1].first;
+    const double wait = settled[k].second / c_s;  // the crack's length after the previous growth
+    std::printf("growth %zu: %.3e s after the previous one; the wait L / c_s is %.3e s\n", k, gap, wait);
+    EXPECT_GE(gap, wait - 1e-12);
+    EXPECT_LE(gap, wait + 5 * dt2 + 1e-12);
+  }
+}
+
 // A pressurised edge crack in the stiffer of two bonded layers, parallel to
 // the interface and a few cells below it, turns towards the softer layer
 // (cracks are drawn to compliant material: the mismatch gives K_II of the

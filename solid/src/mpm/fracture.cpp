@@ -64,6 +64,8 @@
 namespace hfmpm::solid::mpm {
 namespace {
 
+constexpr double kForever = std::numeric_limits<double>::infinity();
+
 // 1D plateau: 1 for r <= ri, linear to 0 at ro; value and d/dr.
 struct Ramp {
   double f = 0, df = 0;
@@ -325,8 +327,17 @@ int Solver::propagate() {
   last_tips_ = tips();
   const double h = config_.grid.h;
   int added = 0;
+  if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
   for (const auto& tip : last_tips_) {
     const bool straight = config_.fracture.straight;
+    double& grown_at = grown_at_[tip.crack][tip.at_end ? 1 : 0];
+    if (config_.fracture.settle_transits > 0 && grown_at > -kForever) {
+      const double length = arc_length(cracks_[tip.crack].plane()).back();
+      const int r = region_at(tip.position);
+      const auto m = static_cast<std::size_t>(r >= 0 ? config_.regions[static_cast<std::size_t>(r)].material : 0);
+      const double c_s = std::sqrt(shear_[m] / density_[m]);
+      if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
+    }
     if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
     if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
       const double dry = arc_length(cracks_[tip.crack].plane()).back() - cracks_[tip.crack].wetted_length();
@@ -344,6 +355,7 @@ int Solver::propagate() {
     } else {
       crack.prepend(next);
     }
+    grown_at = t_;
     ++added;
   }
   return added;

@@ -80,6 +80,11 @@ struct Fracture {
   // it lies more than max_lag_cells cells (along the crack) beyond the fluid
   // front the fluid reported. Negative: no limit (and no effect without a fluid).
   double max_lag_cells = -1;
+  // After a tip grows it is not checked again for settle_transits x L / c_s
+  // (L its crack's length, c_s the shear-wave speed at the tip, with the
+  // scaled density): the time the crack's opening needs to follow the new
+  // length. 0: no wait.
+  double settle_transits = 0;
 };
 
 struct SolidConfig {

@@ -135,6 +135,7 @@ class Solver {
 
   SolidConfig config_;
   std::vector<TipResult> last_tips_;
+  std::vector<std::array<double, 2>> grown_at_;  // s, last growth of each crack's (start, end) tip
   double feedback_alpha_ = 0;
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
