@@ -83,6 +83,12 @@ RunSummary Coupler::run() {
   manifest_.set_number("solid_compute_s", summary.solid_compute_s);
   if (sides_[1].expected) manifest_.set_number("fluid_compute_s", summary.fluid_compute_s);
   if (step_ > 0) manifest_.set_number("coupling_overhead_us_per_step", summary.overhead_per_step_us());
+  if (energy_) {
+    manifest_.set_number("inlet_work_j", energy_->inlet_work());
+    manifest_.set_number("initial_fill_energy_j", energy_->initial_energy());
+    manifest_.set_number("max_kinetic_energy_over_inlet_work", energy_->largest_ratio());
+    manifest_.set_number("max_kinetic_energy_over_inlet_work_t_s", energy_->largest_ratio_time());
+  }
   if (prepared_) manifest_.save();
   return summary;
 }

@@ -130,6 +130,10 @@ void Coupler::step_loop(RunSummary& summary) {
   const std::uint64_t block = (std::uint64_t{scene_.coupling().control_interval()} + k - 1) / k * k;
   double dt = next_dt();
   history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+  if (sides_[1].expected) {
+    energy_ = std::make_unique<EnergyWatch>(scene_.coupling().energy_bound());
+    energy_->start(sides_[1].diagnostics);
+  }
   std::uint64_t frame = 1;
   double next_output = interval;
   double mean_command_s = 0;
@@ -178,6 +182,12 @@ void Coupler::step_loop(RunSummary& summary) {
       side.diagnostics = proto::from_proto(side.report->diagnostics());
       side.compute_s += side.report->compute_s();
       side.exchange_s += side.report->exchange_s();
+    }
+    if (energy_) {
+      if (auto failure = energy_->update(t_, step_, sides_[0].diagnostics, sides_[1].diagnostics)) {
+        history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+        throw RunFailure{*failure};
+      }
     }
     if (output) {  // dt_s: the step that led to this row
       history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "hfmpm/coupling/coupler.hpp"
+#include "hfmpm/coupling/energy_watch.hpp"
 
 #include <unistd.h>
 
@@ -138,6 +139,7 @@ class Coupler {
   Clock::time_point start_ = Clock::now(), last_housekeeping_{};
   std::uint64_t step_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
+  std::unique_ptr<EnergyWatch> energy_;
   double t_ = 0;
 };
 

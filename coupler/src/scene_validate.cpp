@@ -97,6 +97,8 @@ void check_coupling(Checker& c, const scene::Coupling& k) {
   c.range("coupling.join_timeout_s", k.join_timeout_s(), 0, 86400, true, "s");
   if (k.tcp_host().empty()) c.bad("coupling.tcp_host", "\"\"", "a host name or address to bind, e.g. 127.0.0.1");
   if (k.spin_us() > 1000000) c.bad("coupling.spin_us", std::to_string(k.spin_us()), "0 to 1000000 (us)");
+  c.range("coupling.energy_bound", k.energy_bound(), 0, 1e12, false,
+          "0 (no check) or a factor: the solid's kinetic energy may reach it x the fluid's inlet work plus p0 V0");
 }
 
 void check_prescribed_crack(Checker& c, const scene::PrescribedCrack& p) {

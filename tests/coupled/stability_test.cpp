@@ -125,5 +125,45 @@ TEST(Stability, WaterStiffFluidStopsTheRunWithADiagnosis) {
   expect_runaway_diagnosed("bulk_2GPa", "fluid.mpm.bulk_modulus_pa=2e9");
 }
 
+// An exchange every 4 steps at h = 0.05 m and cfl 0.4 (kgd-viscosity; the
+// run-time sweep's "xi4", docs/performance.md): the staggered exchange
+// creates energy, the inlet pressure spikes to 100 MPa and the fluid swells
+// to 20x its injected volume, yet no particle moves a cell in a step, so the
+// runaway check does not fire and the run used to end "completed" with the
+// crack stuck. The coupler's energy check (coupling.energy_bound: the solid's
+// kinetic energy against the inlet's work plus p0 V0) stops it within a few
+// control rounds (measured: step 60, 26x the bound) and says what to change.
+TEST(Stability, EnergyCreatedByTheExchangeStopsTheRunWithADiagnosis) {
+  const auto out = scratch_dir("stability_exchange_4");
+  const auto result =
+      run({bin("hfmpm"), "run", source("scenarios/kgd-viscosity.scene"), "--out", out, "--quiet", "--set",
+           "coupling.exchange_interval=4", "--set", "solid.mpm.cell_size_m=0.05", "--set",
+           "solid.mpm.grid.y_min_m=-5.225", "--set", "solid.mpm.grid.y_max_m=5.225", "--set",
+           "solid.mpm.grid.x_max_m=5.15", "--set", "solid.mpm.cfl=0.4", "--set", "time.end_s=0.5"},
+          300);
+  EXPECT_NE(result.exit_code, 0);
+  for (const char* part : {"energy is being created", "kinetic energy", "inlet work", "coupling.energy_bound",
+                           "coupling.exchange_interval: 1"}) {
+    EXPECT_NE(result.err.find(part), std::string::npos) << part << " not in: " << result.err;
+  }
+  const Csv h = read_csv(out + "/history.csv");  // readable, with the failing round's row
+  EXPECT_GE(h.values("time_s").size(), 2u);
+  const std::string manifest = read_file(out + "/run.json");
+  EXPECT_NE(manifest.find("\"status\": \"failed\""), std::string::npos) << manifest;
+  const auto at = result.err.find("at step ");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_LT(std::stoi(result.err.substr(at + 8)), 200) << "detected late";
+  // The same settings with the check off run on: the check is what stops it.
+  const auto unchecked = scratch_dir("stability_exchange_4_unchecked");
+  const auto off = run({bin("hfmpm"), "run", source("scenarios/kgd-viscosity.scene"), "--out", unchecked, "--quiet",
+                        "--set", "output.hdf5=false", "--set", "coupling.exchange_interval=4", "--set",
+                        "solid.mpm.cell_size_m=0.05", "--set", "solid.mpm.grid.y_min_m=-5.225", "--set",
+                        "solid.mpm.grid.y_max_m=5.225", "--set", "solid.mpm.grid.x_max_m=5.15", "--set",
+                        "solid.mpm.cfl=0.4", "--set", "time.end_s=0.1", "--set", "output.interval_s=0.05", "--set",
+                        "coupling.energy_bound=0"},
+                       300);
+  EXPECT_EQ(off.exit_code, 0) << off.err;
+}
+
 }  // namespace
 }  // namespace hfmpm::test

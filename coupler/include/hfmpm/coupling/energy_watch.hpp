@@ -1,0 +1,52 @@
+// A run-time energy check for coupled runs: the solid's kinetic energy
+// against the energy the fluid can have given it, E = W_in + p0 V0: the work
+// the inlet has done, W_in = integral of p_inlet dV_injected, plus the
+// initial fill's p0 V0 (its inlet pressure times its volume at the start, the
+// work it would do doubling its volume at that pressure; a generous scale for
+// its stored energy, p0^2 V0 / 2K). With loads that do no work of their own
+// (constant tractions, a confining stress held by them, as in every
+// hydraulic-fracture scene) the fluid is the only source of energy, so
+// KE <= E; dissipation (viscous flow, grid damping, PIC) keeps it well below
+// (docs/stability.md lists the measured ratios). A
+// coupled step that creates energy (an exchange interval or a fluid too stiff
+// for the explicit exchange) can run away while no particle moves a cell in
+// one step, and then ends "completed" with a wrong answer; this turns it into
+// a named failure. No sockets here: the coupler feeds it the reports'
+// diagnostics.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "hfmpm/exchange.hpp"
+
+namespace hfmpm::coupling {
+
+class EnergyWatch {
+ public:
+  // bound: KE may reach bound x W_in (0: no check, only bookkeeping);
+  explicit EnergyWatch(double bound) : bound_(bound) {}
+
+  // The fluid's state at the start (the Ready report).
+  void start(const SideDiagnostics& fluid);
+
+  // After each command (every control round): accumulate W_in (trapezoid
+  // over the reports) and check. Returns the failure's text, or nullopt.
+  std::optional<std::string> update(double t, std::uint64_t step, const SideDiagnostics& solid,
+                                    const SideDiagnostics& fluid);
+
+  double inlet_work() const { return work_; }        // J/m
+  double initial_energy() const { return e0_; }      // J/m, p0 V0
+  double largest_ratio() const { return largest_; }  // max KE / (W_in + p0 V0)
+  double largest_ratio_time() const { return largest_t_; }
+
+ private:
+  double bound_;
+  double e0_ = 0;
+  double p_ = 0, v_ = 0;  // last inlet pressure and injected volume
+  double work_ = 0;
+  double largest_ = 0, largest_t_ = 0;
+};
+
+}  // namespace hfmpm::coupling

@@ -1,0 +1,42 @@
+#include "hfmpm/coupling/energy_watch.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace hfmpm::coupling {
+
+void EnergyWatch::start(const SideDiagnostics& fluid) {
+  p_ = fluid.inlet_pressure;
+  v_ = fluid.injected_volume;
+  e0_ = std::max(0.0, fluid.inlet_pressure * fluid.fluid_volume);
+}
+
+std::optional<std::string> EnergyWatch::update(double t, std::uint64_t step, const SideDiagnostics& solid,
+                                               const SideDiagnostics& fluid) {
+  work_ += 0.5 * (p_ + fluid.inlet_pressure) * (fluid.injected_volume - v_);
+  p_ = fluid.inlet_pressure;
+  v_ = fluid.injected_volume;
+  const double available = work_ + e0_;
+  if (!(available > 0)) return std::nullopt;
+  const double ratio = solid.kinetic_energy / available;
+  if (ratio > largest_) {
+    largest_ = ratio;
+    largest_t_ = t;
+  }
+  if (bound_ <= 0 || !(ratio > bound_)) return std::nullopt;
+  std::ostringstream out;
+  out << "energy is being created: at step " << step << " (t = " << t << " s) the solid's kinetic energy is "
+      << solid.kinetic_energy << " J/m, " << ratio << " x the energy the fluid can have given it ("
+      << available << " J/m: " << work_ << " J/m of inlet work and " << e0_
+      << " J/m for the initial fill, p0 V0; the bound is " << bound_
+      << " x, coupling.energy_bound). The inlet pressure is "
+      << fluid.inlet_pressure << " Pa, the fluid volume " << fluid.fluid_volume << " m^2 against "
+      << fluid.injected_volume << " m^2 injected, the mouth opening " << solid.mouth_opening
+      << " m. The coupled step is unstable: exchange every step (coupling.exchange_interval: 1), lower "
+         "time.safety_factor or solid.mpm.cfl, or soften the fluid (fluid.mpm.bulk_modulus_pa). A scene whose "
+         "tractions do work of their own can raise coupling.energy_bound or set it to 0 (no check).";
+  return out.str();
+}
+
+}  // namespace hfmpm::coupling

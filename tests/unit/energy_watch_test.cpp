@@ -1,0 +1,68 @@
+// The coupler's energy check (coupler/include/hfmpm/coupling/energy_watch.hpp):
+// the inlet work it integrates against the exact integral of a known
+// pressure and flow history, and the bound it enforces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "hfmpm/coupling/energy_watch.hpp"
+
+namespace hfmpm::coupling {
+namespace {
+
+SideDiagnostics fluid_at(double p, double injected, double volume) {
+  SideDiagnostics d;
+  d.inlet_pressure = p;
+  d.injected_volume = injected;
+  d.fluid_volume = volume;
+  return d;
+}
+
+SideDiagnostics solid_with(double kinetic_energy) {
+  SideDiagnostics d;
+  d.kinetic_energy = kinetic_energy;
+  return d;
+}
+
+// p(t) = p0 + a t, V(t) = q t: W = integral p dV = q (p0 t + a t^2 / 2). The
+// trapezoid is exact for this (p linear in V), so the sum over 100 reports
+// matches to round-off. The initial fill's p0 V0 is added to the scale.
+TEST(EnergyWatch, IntegratesTheInletWorkExactlyForALinearRamp) {
+  constexpr double p0 = 2e6, a = 1.25e5, q = 1e-3, v0 = 2e-3, t_end = 8;
+  EnergyWatch watch(1.0);
+  watch.start(fluid_at(p0, 0, v0));
+  EXPECT_DOUBLE_EQ(watch.initial_energy(), p0 * v0);
+  for (int k = 1; k <= 100; ++k) {
+    const double t = t_end * k / 100;
+    EXPECT_FALSE(watch.update(t, static_cast<std::uint64_t>(k), solid_with(0), fluid_at(p0 + a * t, q * t, v0 + q * t)));
+  }
+  const double exact = q * (p0 * t_end + a * t_end * t_end / 2);
+  EXPECT_NEAR(watch.inlet_work(), exact, 1e-12 * exact);
+}
+
+// Below the bound nothing happens and the largest ratio is recorded; above
+// it the text names the quantity, the step, the time and what to change.
+TEST(EnergyWatch, FailsWhenTheKineticEnergyExceedsTheBoundAndSaysWhy) {
+  EnergyWatch watch(1.0);
+  watch.start(fluid_at(1e5, 0, 4e-6));  // p0 V0 = 0.4 J/m
+  // 1e5 Pa over 1e-3 m^2: 100 J/m of inlet work, 100.4 J/m in all.
+  EXPECT_FALSE(watch.update(0.1, 20, solid_with(50), fluid_at(1e5, 1e-3, 1e-3)));
+  EXPECT_NEAR(watch.largest_ratio(), 50 / 100.4, 1e-12);
+  const auto failure = watch.update(0.2, 40, solid_with(150), fluid_at(1e5, 1e-3, 2e-2));
+  ASSERT_TRUE(failure);
+  for (const char* part : {"kinetic energy", "step 40", "t = 0.2 s", "coupling.energy_bound",
+                           "coupling.exchange_interval", "fluid.mpm.bulk_modulus_pa"}) {
+    EXPECT_NE(failure->find(part), std::string::npos) << part << " missing from: " << *failure;
+  }
+}
+
+// energy_bound 0: bookkeeping only, never a failure.
+TEST(EnergyWatch, BoundZeroOnlyRecords) {
+  EnergyWatch watch(0.0);
+  watch.start(fluid_at(1e5, 0, 0));
+  EXPECT_FALSE(watch.update(0.1, 20, solid_with(1e9), fluid_at(1e5, 1e-3, 1e-3)));
+  EXPECT_NEAR(watch.largest_ratio(), 1e9 / 100, 1e-3);
+}
+
+}  // namespace
+}  // namespace hfmpm::coupling
