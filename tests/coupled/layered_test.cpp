@@ -21,7 +21,7 @@
 // counts when the path is more than a quarter cell off its line (crack
 // particles are half a cell apart and each growth step may kink); the
 // viscosity effect is asserted as more than a tenth of a cell at the shorter
-// path's reach, where it measures 0.39 m (docs/verification.md).
+// path's reach, where it measures 0.77 m (docs/verification.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -94,16 +94,22 @@ TEST(Layered, StartedInTheStiffLayerItTurnsTowardTheSoftOneAndMoreSoWithAMoreVis
   const Path thick = run_layered("stiff_mu1e-2", 1e-2, false);
   ASSERT_FALSE(thin.x.empty());
   ASSERT_FALSE(thick.x.empty());
-  // Compared at the shorter path's reach: measured +1.28 m (1e-2) against +0.89 m
-  // (1e-3) at x = 10.15 m, mean offsets from the notch's tip +0.43 and +0.34 m;
-  // at full size +0.99 against +0.77 m at x = 10.31 m. (The faster 1e-3 crack's
-  // own tip wanders back to its line by the end: it is compared where both are.)
+  // Each path's tip ends more than a quarter cell toward the soft layer; the
+  // viscous one never turns a quarter cell away from it; the two are compared
+  // at the shorter path's reach. Measured (time step 0.25 of the stable one):
+  // tips +0.93 m (1e-3, at x = 14.90 m) and +0.81 m (1e-2, at 9.98 m); at
+  // x = 9.98 m +0.04 and +0.81 m, mean offsets from the notch's tip +0.08 and
+  // +0.49 m. The faster 1e-3 crack weaves (down to -0.30 m, near its line at
+  // 10 m, up again by its tip), so only its end is asserted. Steps of 0.9 and
+  // 0.5 of the stable one created energy in some of these runs (the
+  // coupler's energy check, docs/stability.md).
   const double at = std::min(thin.reach(), thick.reach());
   for (const Path* p : {&thin, &thick}) {
     EXPECT_GT(p->reach(), kNotchTip + 2 * kCell) << "the crack must grow more than the zero-lag closure allows";
-    EXPECT_GT(p->y_at(at), kQuarterCell) << "toward the soft layer (y > 0) at x = " << at << " m";
+    EXPECT_GT(p->y.back(), kQuarterCell) << "the tip ends toward the soft layer (y > 0)";
     EXPECT_LT(*std::max_element(p->y.begin(), p->y.end()), kInterface) << "it turns toward the bond, not across it";
   }
+  EXPECT_GT(*std::min_element(thick.y.begin(), thick.y.end()), -kQuarterCell) << "1e-2 never turns away from it";
   const double d_thin = thin.y_at(at), d_thick = thick.y_at(at);
   std::printf("deviation at x = %.2f m: mu 1e-3 %+.3f m, mu 1e-2 %+.3f m; mean offset from x = 4 m: %+.3f m, %+.3f m\n",
               at, d_thin, d_thick, thin.mean_y(kNotchTip, at), thick.mean_y(kNotchTip, at));
