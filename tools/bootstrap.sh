@@ -30,7 +30,7 @@ cmake --build --preset release -j "$jobs"
 
 case "$mode" in
   run)
-    # The CI-size viscosity-dominated KGD fracture (about 80 s on 2 cores),
+    # The CI-size viscosity-dominated KGD fracture (about 40 s on 2 cores),
     # compared with the M-vertex in the printed table and in kgd.png.
     out=hfmpm-out/kgd-viscosity-ci
     build/release/bin/hfmpm run scenarios/kgd-viscosity-ci.scene --out "$out"

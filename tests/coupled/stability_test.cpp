@@ -16,9 +16,10 @@
 //   without confinement. Each particle's mass is constant and merging adds
 //   masses, so the mass itself is conserved by construction.)
 // Inputs that do blow up must stop the run within a few steps, exit non-zero,
-// name the runaway particle and the pressure spike with what to change, and
-// leave their output readable: a flow-rate inlet into a 10 nm film, and a
-// water-stiff fluid (K = 2 GPa), which runs away at 0.034 s (docs/stability.md).
+// name what blew up with what to change, and leave their output readable: a
+// flow-rate inlet into a 10 nm film (the runaway particle and the pressure
+// spike), and a water-stiff fluid (K = 2 GPa: the coupler's energy check at
+// step 20; docs/stability.md).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -99,30 +100,37 @@ TEST(Stability, TenTimesTheEndTime) { expect_sane({"long", {"time.end_s=15"}, kF
 // must stop the run at the first particle that moves more than a cell in a
 // step, say which and where, name the face pressure and what to change, and
 // keep the output.
-void expect_runaway_diagnosed(const char* name, const std::string& set) {
+void expect_runaway_diagnosed(const char* name, const std::string& set, const std::vector<const char*>& parts) {
   const auto out = scratch_dir(std::string("stability_") + name);
   const auto result = run({bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out, "--quiet",
                            "--set", set},
                           300);
   EXPECT_NE(result.exit_code, 0);
-  for (const char* part : {"ran away at step", "particle", "cells in one step", "Largest crack face pressure",
-                           "virtual_opening_m", "solid.mpm.cfl"}) {
+  for (const char* part : parts) {
     EXPECT_NE(result.err.find(part), std::string::npos) << part << " not in: " << result.err;
   }
   const Csv h = read_csv(out + "/history.csv");  // readable, with the rows written before the failure
   EXPECT_GE(h.values("time_s").size(), 1u);
   const std::string manifest = read_file(out + "/run.json");
   EXPECT_NE(manifest.find("\"status\": \"failed\""), std::string::npos) << manifest;
-  const auto steps = manifest.find("failed at step ");
+  const auto steps = result.err.find("at step ");  // the failing step, named in the message
   ASSERT_NE(steps, std::string::npos);
-  EXPECT_LT(std::stoi(manifest.substr(steps + 15)), 100) << "detected late";
+  EXPECT_LT(std::stoi(result.err.substr(steps + 8)), 100) << "detected late";
 }
 
+const std::vector<const char*> kRunawayParts = {"ran away at step", "particle", "cells in one step",
+                                                "Largest crack face pressure", "virtual_opening_m", "solid.mpm.cfl"};
+
 TEST(Stability, PressureSpikeStopsTheRunWithADiagnosis) {
-  expect_runaway_diagnosed("spike", "fluid.mpm.virtual_opening_m=1e-8");
+  expect_runaway_diagnosed("spike", "fluid.mpm.virtual_opening_m=1e-8", kRunawayParts);
 }
+// The water-stiff fluid now trips the coupler's energy check first: at the
+// first control round (step 20, 0.0115 s: the solid's kinetic energy 43 x
+// what the fluid can have given it), before any particle moves a cell (the
+// runaway check fired at step 59).
 TEST(Stability, WaterStiffFluidStopsTheRunWithADiagnosis) {
-  expect_runaway_diagnosed("bulk_2GPa", "fluid.mpm.bulk_modulus_pa=2e9");
+  expect_runaway_diagnosed("bulk_2GPa", "fluid.mpm.bulk_modulus_pa=2e9",
+                           {"energy is being created", "at step", "kinetic energy", "fluid.mpm.bulk_modulus_pa"});
 }
 
 // An exchange every 4 steps at h = 0.05 m and cfl 0.4 (kgd-viscosity; the
