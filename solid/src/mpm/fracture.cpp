@@ -193,6 +193,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
       }
     }
   }
+  tip.material = material;
   tip.modulus = config_.materials[material].plane_strain_modulus();
   tip.toughness = config_.materials[material].toughness;
   const double mu = shear_[material];
@@ -333,9 +334,7 @@ int Solver::propagate() {
     double& grown_at = grown_at_[tip.crack][tip.at_end ? 1 : 0];
     if (config_.fracture.settle_transits > 0 && grown_at > -kForever) {
       const double length = arc_length(cracks_[tip.crack].plane()).back();
-      const int r = region_at(tip.position);
-      const auto m = static_cast<std::size_t>(r >= 0 ? config_.regions[static_cast<std::size_t>(r)].material : 0);
-      const double c_s = std::sqrt(shear_[m] / density_[m]);
+      const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
       if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
     }
     if (!(growth_energy(tip, straight) >= tip.toughness)) continue;

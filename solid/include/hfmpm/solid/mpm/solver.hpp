@@ -37,6 +37,7 @@ struct TipResult {
   double kink = 0;       // rad, growth direction by maximum hoop stress, counter-clockwise from direction
   double toughness = 0;  // J/m^2, J_Ic of the material at the tip
   double modulus = 0;    // Pa, plane-strain E' there
+  std::size_t material = 0;  // index of the material at the tip
 };
 
 // J/m^2: the energy release rate that drives growth, J without the share of
