@@ -8,7 +8,9 @@ h = 0.035 m, notch 0.15 m, 1.5 s) with one input, or a few, pushed per case (the
 CASES below; `--only` takes names or PREFIX*), and sorts each run into
 - "passed": it ended normally and every check holds;
 - "blew up, detected": it exited non-zero, run.json says failed, and the message names the
-  runaway ("ran away at step", the particle, the face pressure and what to change);
+  runaway: the solid's ("ran away at step", the particle, the face pressure and what to change)
+  or the coupler's energy check ("energy is being created: at step", the kinetic energy against
+  the fluid's work and what to change);
 - "FAILED CHECK (which)": it ended normally but a check fails, or it failed in another way.
 The checks are those of tests/coupled/stability_test.cpp (which says why each bound), on
 history.csv, plus two on solid.h5:
@@ -80,6 +82,10 @@ CASES = [
     ("K_3e8", "fluid bulk modulus 300 MPa", ["fluid.mpm.bulk_modulus_pa=3e8"], "passes"),
     ("K_1e9", "fluid bulk modulus 1 GPa", ["fluid.mpm.bulk_modulus_pa=1e9"], "passes"),
     ("K_2e9", "fluid bulk modulus 2 GPa (water)", ["fluid.mpm.bulk_modulus_pa=2e9"], "blows up"),
+    ("K_3e8_step0.45", "fluid 300 MPa at half the coupled step (time.safety_factor 0.45)",
+     ["fluid.mpm.bulk_modulus_pa=3e8", "time.safety_factor=0.45"], "passes"),
+    ("K_2e9_step0.15", "water (2 GPa) at a sixth of the coupled step (time.safety_factor 0.15)",
+     ["fluid.mpm.bulk_modulus_pa=2e9", "time.safety_factor=0.15"], "passes"),
     ("mu_1e-4", "viscosity 1e-4 Pa s", ["fluid.mpm.viscosity_pa_s=1e-4"], "passes"),
     ("mu_1e-3", "viscosity 1e-3 Pa s (water)", ["fluid.mpm.viscosity_pa_s=1e-3"], "passes"),
     ("mu_1e-1", "viscosity 0.1 Pa s", ["fluid.mpm.viscosity_pa_s=0.1"], "passes"),
@@ -275,11 +281,19 @@ def one(exe, out_root, case, a):
         readable = f"; history.csv unreadable: {e}"
     runaway = re.search(r"ran away at step (\d+) \(t = ([^ )]+) s\).*?([\d.]+) cells in one step.*?"
                         r"Largest crack face pressure: ([^ ]+) Pa", msg)
+    energy = re.search(r"energy is being created: at step (\d+) \(t = ([^ )]+) s\) the solid's kinetic energy is "
+                       r"([^ ]+) J/m, ([^ ]+) x the energy", msg)
     if res["rc"] != 0 and status == "failed" and runaway:
         row["outcome"] = "blew up, detected"
         row["steps"] = int(runaway.group(1))  # run.json counts the steps of the last completed control round
         row["runaway"] = (f"ran away at step {runaway.group(1)} (t = {runaway.group(2)} s), a particle moved "
                           f"{runaway.group(3)} cells in a step; largest face pressure {float(runaway.group(4)):.3g} Pa")
+    elif res["rc"] != 0 and status == "failed" and energy:  # the coupler's energy check (docs/stability.md)
+        row["outcome"] = "blew up, detected"
+        row["steps"] = int(energy.group(1))
+        row["runaway"] = (f"energy check at step {energy.group(1)} (t = {energy.group(2)} s): kinetic energy "
+                          f"{float(energy.group(3)):.3g} J/m, {float(energy.group(4)):.3g} x what the fluid can "
+                          f"have given")
     else:
         row["outcome"] = f"FAILED CHECK (run ended: exit {res['rc']}, status {status})"
     row["detail"] = msg + readable
