@@ -10,9 +10,12 @@
 //   the path bends toward the interface;
 // - in the softer layer the K_II has the other sign: the crack turns away from
 //   the stiff layer (it stays in the soft one);
-// - a more viscous fluid turns it more (the method paper's finding): at the same
-//   distance from the mouth the path of mu = 1e-2 Pa s lies further toward the
-//   soft layer than that of 1e-3 Pa s;
+// - a more viscous fluid turns it more (the method paper's finding): two cells
+//   past the notch (x = 6 m, which every growing crack reaches) the path of
+//   mu = 1e-2 Pa s lies further toward the soft layer than that of 1e-3 Pa s.
+//   Further on the paths are not converged in the time step (at 0.25, 0.1 and
+//   0.05 of the stable step the order at x = 8 m changes), so they are not
+//   compared there (docs/verification.md, "Layered medium");
 // - a fluid of 1 Pa s does not enter the crack fast enough to grow it by the
 //   end time under the same ramp.
 // Bounds, in cells (h = 1 m): a crack "grew" when it went more than 2 cells past
@@ -20,8 +23,10 @@
 // the fluid, and J_Ic = 5 J/m^2 lets the start's transient do that); a turn
 // counts when the path is more than a quarter cell off its line (crack
 // particles are half a cell apart and each growth step may kink); the
-// viscosity effect is asserted as more than a tenth of a cell at the shorter
-// path's reach, where it measures 0.77 m (docs/verification.md).
+// viscosity effect at x = 6 m is asserted as more than a twentieth of a cell:
+// it measures 0.08 to 0.14 m at every step (0.25, 0.1, 0.05 of the stable
+// one) and fluid stiffness (2e8, 2e9 Pa) where both cracks reach 6 m, while
+// below 0.25 the step moves each path there by at most 0.06 m.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -38,7 +43,7 @@ namespace {
 
 constexpr double kNotchTip = 4;   // m, the initial crack runs from x = 0 to 4 at y = 0
 constexpr double kInterface = 4;  // m, y of the bond between the layers
-constexpr double kCell = 1, kQuarterCell = 0.25, kTenthCell = 0.1;
+constexpr double kCell = 1, kQuarterCell = 0.25, kTwentiethCell = 0.05;
 
 struct Path {
   std::vector<double> x, y;
@@ -94,27 +99,23 @@ TEST(Layered, StartedInTheStiffLayerItTurnsTowardTheSoftOneAndMoreSoWithAMoreVis
   const Path thick = run_layered("stiff_mu1e-2", 1e-2, false);
   ASSERT_FALSE(thin.x.empty());
   ASSERT_FALSE(thick.x.empty());
-  // Each path's tip ends more than a quarter cell toward the soft layer; the
-  // viscous one never turns a quarter cell away from it; the two are compared
-  // at the shorter path's reach. Measured (time step 0.25 of the stable one):
-  // tips +0.93 m (1e-3, at x = 14.90 m) and +0.81 m (1e-2, at 9.98 m); at
-  // x = 9.98 m +0.04 and +0.81 m, mean offsets from the notch's tip +0.08 and
-  // +0.49 m. The faster 1e-3 crack weaves (down to -0.30 m, near its line at
-  // 10 m, up again by its tip), so only its end is asserted. Steps of 0.9 and
-  // 0.5 of the stable one created energy in some of these runs (the
-  // coupler's energy check, docs/stability.md).
-  const double at = std::min(thin.reach(), thick.reach());
+  // Each path's tip ends more than a quarter cell toward the soft layer and
+  // never turns a quarter cell away from it; the two are compared two cells
+  // past the notch. Measured (water, time step 0.1 of the stable one): see
+  // docs/verification.md; the test prints the figures. Steps of 0.9 and 0.5
+  // of the stable one created energy in some of these runs (the coupler's
+  // energy check, docs/stability.md).
+  const double at = kNotchTip + 2 * kCell;
   for (const Path* p : {&thin, &thick}) {
     EXPECT_GT(p->reach(), kNotchTip + 2 * kCell) << "the crack must grow more than the zero-lag closure allows";
     EXPECT_GT(p->y.back(), kQuarterCell) << "the tip ends toward the soft layer (y > 0)";
+    EXPECT_GT(*std::min_element(p->y.begin(), p->y.end()), -kQuarterCell) << "it never turns away from it";
     EXPECT_LT(*std::max_element(p->y.begin(), p->y.end()), kInterface) << "it turns toward the bond, not across it";
   }
-  EXPECT_GT(*std::min_element(thick.y.begin(), thick.y.end()), -kQuarterCell) << "1e-2 never turns away from it";
   const double d_thin = thin.y_at(at), d_thick = thick.y_at(at);
   std::printf("deviation at x = %.2f m: mu 1e-3 %+.3f m, mu 1e-2 %+.3f m; mean offset from x = 4 m: %+.3f m, %+.3f m\n",
               at, d_thin, d_thick, thin.mean_y(kNotchTip, at), thick.mean_y(kNotchTip, at));
-  EXPECT_GT(d_thick, d_thin + kTenthCell) << "at x = " << at << " m";
-  EXPECT_GT(thick.mean_y(kNotchTip, at), thin.mean_y(kNotchTip, at)) << "from x = 4 m to " << at << " m";
+  EXPECT_GT(d_thick, d_thin + kTwentiethCell) << "at x = " << at << " m";
 }
 
 TEST(Layered, StartedInTheSoftLayerItStaysThere) {
