@@ -229,9 +229,27 @@ def grid_for(tree, h, margin_cells=3):
             f"solid.mpm.grid.x_max_m={x:.10g}"]
 
 
-# 2 x 2 particles per cell everywhere (the scene has 1 in the far field and 2 x 2 around the crack)
-UNIFORM_PPC2 = ('solid.mpm.regions=[{material: "rock" rectangle { x_min_m: 0 y_min_m: -5.05 x_max_m: 5 '
-                'y_max_m: 5.05 } initial_stress { xx_pa: -1e5 yy_pa: -1e5 } particles_per_cell: 2}]')
+def uniform_particles(tree, n):
+    """--set value: the scene's largest region (its body) alone, with n x n particles per cell everywhere
+    (kgd-viscosity has 1 in the far field and 2 x 2 around the crack). Derived from the validated scene,
+    so it follows the scene's body, material and in-situ stress."""
+    regions = get_all(tree, "solid.mpm.regions")
+    if not regions or any("rectangle" not in r for r in regions):
+        die("the particles-per-cell case needs the scene's regions to be rectangles")
+
+    def area(r):
+        b = r["rectangle"][0]
+        return (b["x_max_m"][0] - b["x_min_m"][0]) * (b["y_max_m"][0] - b["y_min_m"][0])
+
+    body = max(regions, key=area)
+
+    def numbers(d):
+        return " ".join(f"{k}: {v[0]:.10g}" for k, v in d.items())
+    stress = f" initial_stress {{ {numbers(body['initial_stress'][0])} }}" if "initial_stress" in body else ""
+    return (f'solid.mpm.regions=[{{material: "{body["material"][0]}" rectangle {{ {numbers(body["rectangle"][0])} }}'
+            f"{stress} particles_per_cell: {n}}}]")
+
+
 # name: (settings, a cell size h or None, which sweeps: "both", "full" or "quick").
 # The full sweep varies one setting at a time around kgd-viscosity.scene's own (h = 0.04 m,
 # cfl 0.5, density scaling 10, grid damping 5 /s, exchange every step, in-process, 1 particle
@@ -249,7 +267,7 @@ CASES = {
     "xi2": (["coupling.exchange_interval=2"], None, "both"), "xi4": (["coupling.exchange_interval=4"], None, "full"),
     "ipc": (["coupling.transport=IPC"], None, "full"),
     "inproc": (["coupling.transport=INPROC"], None, "quick"),
-    "ppc2": ([UNIFORM_PPC2], None, "full"),
+    "ppc2": ([lambda tree: uniform_particles(tree, 2)], None, "full"),  # derived from the scene
     "h0.035_cfl0.4": (["solid.mpm.cfl=0.4"], 0.035, "full"),
 }
 QUICK_END_S = 3.5
@@ -377,7 +395,7 @@ def main():
     rows = []
     for i, name in enumerate(names):
         sets, h, _ = CASES[name]
-        sets = common + (grid_for(tree, h) if h else []) + sets
+        sets = common + (grid_for(tree, h) if h else []) + [x(tree) if callable(x) else x for x in sets]
         hh = h or h0
         row = {"name": name, "settings": " ".join(s for s in sets if not s.startswith("time.end_s")) or "(scene)",
                "h_m": hh, "notch_cells": L0 / hh, "cells_per_final_half_length": L_end / hh}
