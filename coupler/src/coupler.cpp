@@ -88,6 +88,9 @@ RunSummary Coupler::run() {
     manifest_.set_number("initial_fill_energy_j", energy_->initial_energy());
     manifest_.set_number("max_kinetic_energy_over_inlet_work", energy_->largest_ratio());
     manifest_.set_number("max_kinetic_energy_over_inlet_work_t_s", energy_->largest_ratio_time());
+    // The fluid's pressure change at frozen crack width (docs/stability.md, "The stiff-fluid lag").
+    manifest_.set_number("max_coupling_lag_pa", max_coupling_lag_);
+    manifest_.set_number("max_coupling_lag_t_s", max_coupling_lag_t_);
   }
   if (prepared_) manifest_.save();
   return summary;

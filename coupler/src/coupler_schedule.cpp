@@ -183,6 +183,10 @@ void Coupler::step_loop(RunSummary& summary) {
       side.compute_s += side.report->compute_s();
       side.exchange_s += side.report->exchange_s();
     }
+    if (sides_[1].diagnostics.coupling_lag > max_coupling_lag_) {
+      max_coupling_lag_ = sides_[1].diagnostics.coupling_lag;
+      max_coupling_lag_t_ = t_;
+    }
     if (energy_) {
       if (auto failure = energy_->update(t_, step_, sides_[0].diagnostics, sides_[1].diagnostics)) {
         history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));

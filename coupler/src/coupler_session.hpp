@@ -133,6 +133,8 @@ class Coupler {
   bool prepared_ = false;
   bool leak_context_ = false;
   bool stopped_at_max_steps_ = false;
+  // Largest fluid pressure change at frozen crack width over a report, and when (run.json).
+  double max_coupling_lag_ = 0, max_coupling_lag_t_ = 0;
   Log log_;
   Progress progress_;
   microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};

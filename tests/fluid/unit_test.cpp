@@ -303,6 +303,38 @@ TEST(FluidSolver, ReportsTheStiffnessOfItsPressureToTheCrackWidth) {
   }
 }
 
+// The coupling-lag diagnostic: fluid injected into a crack held at a fixed
+// width has nowhere to go but into compression. The inlet injects Q for
+// 0.3 s and stops by 0.4 s (a table); by T = 1 s the pressure has equalised
+// (diffusion time L^2 / (K w^2 / 12 mu) = 0.06 s here, so 10 of them after
+// the inlet stopped), and the rise at every wetted node is the Tait pressure
+// of the whole mass in the fixed volume less the fill pressure. A new
+// set_crack() starts the count again.
+TEST(FluidSolver, FrozenWidthRiseIsThePressureTheInflowBuilt) {
+  FluidConfig c;
+  c.bulk_modulus = 2e6;
+  c.viscosity = 1;
+  const double Q = 1e-6, L = 0.1, w = 1e-3, p0 = 1e5, T = 1;
+  c.inlet.flow_rate = TimeFunction::table({0, 0.3, 0.4}, {Q, Q, 0});
+  FluidSolver fluid(c);
+  fluid.set_crack(test::channel(L, 10, w));
+  fluid.fill(L, p0);
+  EXPECT_EQ(fluid.frozen_width_rise(), 0.0);
+  const double mass0 = fluid.fluid_mass();
+  fluid.advance(T);
+  const double injected = Q * 0.35;  // m^2 at zero pressure: the integral of the table
+  // The inlet's quadrature is exact but at the table's kinks (5e-9 of it here).
+  EXPECT_NEAR(fluid.injected_volume(), injected, 1e-6 * injected);
+  const double J = c.density * L * w / (mass0 + c.density * fluid.injected_volume());
+  const double expected = fluid.eos().pressure_no_tension(J) - p0;
+  // Uniform to the residual of the diffusion, e^-10 (5e-5) of the gradient
+  // the inflow drove (12 mu Q L / w^3 = 1.2 kPa, 4% of the rise): 1e-5 of the rise.
+  EXPECT_NEAR(fluid.frozen_width_rise(), expected, 1e-5 * expected);
+  EXPECT_GT(expected, 0.2 * c.bulk_modulus * injected / (L * w));  // a real rise: about K dV / V
+  fluid.set_crack(test::channel(L, 10, w));
+  EXPECT_EQ(fluid.frozen_width_rise(), 0.0);
+}
+
 // Beyond the front: zero pressure (vapour); with Lag::Front the pressure of
 // the fluid at the front (at most the mouth's) on the first node beyond it
 // and zero further on; with Lag::Fixed the given lag pressure on every node

@@ -200,6 +200,7 @@ TEST(DiagnosticsConvert, RoundTripIsExact) {
   EXPECT_EQ(plain.front_position, 0.6);
   EXPECT_EQ(plain.crack_particles, 101u);
   EXPECT_EQ(plain.fluid_particles, 77u);
+  EXPECT_EQ(plain.coupling_lag, 1.5e3);
   protocol::Diagnostics back;
   hfmpm::proto::to_proto(plain, &back);
   EXPECT_TRUE(MessageDifferencer::Equals(back, message)) << back.ShortDebugString();

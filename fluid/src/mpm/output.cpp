@@ -40,6 +40,7 @@ void FluidSolver::fill(double front, double pressure) {
   outlet_wetted_ = config_.outlet.enabled && front >= grid_.length() * (1 - 1e-12);
   update_state();
   project_pressure();
+  pressure_at_set_ = nodal_pressure_;  // the fill is the start, not a change
 }
 
 void FluidSolver::project_pressure() {
@@ -124,6 +125,20 @@ std::vector<double> FluidSolver::nodal_stiffness() const {
   if (config_.inlet.kind == InletConfig::Kind::Pressure) stiffness[0] = 0;
   if (outlet_wetted_) stiffness[n - 1] = 0;
   return stiffness;
+}
+
+double FluidSolver::frozen_width_rise() const {
+  const std::size_t n = nodal_pressure_.size();
+  if (particles_.size() == 0 || pressure_at_set_.size() != n) return 0.0;
+  const double front = front_position() + 1e-12 * grid_.length();
+  const std::size_t first = config_.inlet.kind == InletConfig::Kind::Pressure ? 1 : 0;
+  const std::size_t end = outlet_wetted_ ? n - 1 : n;
+  double largest = 0;
+  for (std::size_t i = first; i < end; ++i) {
+    if (grid_.arc()[i] > front) break;
+    largest = std::max(largest, std::abs(nodal_pressure_[i] - pressure_at_set_[i]));
+  }
+  return largest;
 }
 
 double FluidSolver::front_position() const {

@@ -49,6 +49,7 @@ void FluidSolver::set_crack(const CrackGeometry& crack) {
   // The particles now see the new widths (F22, and so J and p, change).
   update_state();
   project_pressure();
+  pressure_at_set_ = nodal_pressure_;
 }
 
 void FluidSolver::update_state(std::size_t p) {

@@ -53,6 +53,7 @@ struct SideDiagnostics {
   double injected_volume = 0;  // m^2
   double fluid_volume = 0;     // m^2
   double front_position = 0;   // m
+  double coupling_lag = 0;     // Pa, the fluid's pressure change at frozen crack width over its last exchange window
   std::uint32_t crack_particles = 0;
   std::uint32_t fluid_particles = 0;
 };

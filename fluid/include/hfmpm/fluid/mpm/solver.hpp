@@ -110,6 +110,14 @@ class FluidSolver {
   // coupling of a stiff fluid is otherwise unstable: DESIGN.md 3, docs/fluid.md).
   std::vector<double> nodal_stiffness() const;  // computed when called (once per exchange)
   CrackPressure pressure_message() const;
+  // Pa, the largest change of a wetted node's pressure since the last
+  // set_crack(): what the fluid's pressure did while the crack was frozen
+  // (inflow it compressed, outflow it relaxed). In a coupled run the crack
+  // faces never carried this part of the pressure, and the fluid's flow
+  // over the step was driven by it: with a stiff fluid it is the coupling's
+  // lag error, about K dt (dw/dt) / w (docs/stability.md, "The stiff-fluid
+  // lag"). Nodes whose pressure a boundary holds are left out.
+  double frozen_width_rise() const;
   // m, arc length of the front (the end of the last particle), at most the crack length; 0 when empty.
   double front_position() const;
   // Pa, the pressure held at the mouth: p_in(t), or for a flow-rate inlet
@@ -153,6 +161,7 @@ class FluidSolver {
   ShapeTable shapes_;
   // nodal fields
   std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_;
+  std::vector<double> pressure_at_set_;  // Pa per node, right after the last set_crack
   std::vector<double> drag_k_, widths_floor_;  // scratch per particle
   double particle_length_ = 0;                 // m, resolved target length
   double t_ = 0;
