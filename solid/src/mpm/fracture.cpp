@@ -329,11 +329,17 @@ int Solver::propagate() {
   const double h = config_.grid.h;
   int added = 0;
   if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
+  // Each crack's length before this check grows any tip: the settling wait of
+  // its second tip must not count the growth of its first in the same check
+  // (it did, and the two tips of a point-symmetric crack grew at alternate
+  // checks).
+  std::vector<double> lengths;
+  for (const auto& crack : cracks_) lengths.push_back(arc_length(crack.plane()).back());
   for (const auto& tip : last_tips_) {
     const bool straight = config_.fracture.straight;
     double& grown_at = grown_at_[tip.crack][tip.at_end ? 1 : 0];
     if (config_.fracture.settle_transits > 0 && grown_at > -kForever) {
-      const double length = arc_length(cracks_[tip.crack].plane()).back();
+      const double length = lengths[tip.crack];
       const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
       if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
     }

@@ -88,9 +88,36 @@ void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressu
 
 void Solver::set_crack_front(std::size_t c, double arc_length) { cracks_.at(c).set_wetted_length(arc_length); }
 
-void Solver::crack_loads() {
-  const auto& g = config_.grid;
+// The force of one side's face at crack particle k goes to the nodes around
+// its surface point with the linear weights w, renormalized over the nodes
+// where that side's field has mass, but a field lighter than a quarter of a
+// full node's mass (rho h^2 / 4: the mass of a node at a corner of the body,
+// the lightest a node of whole material has) takes its share in proportion
+// to its mass: w m / (rho h^2 / 4). Without that limit a node whose field for
+// that side held only the corner of one particle (a crack just grown past or
+// through a particle's centre) took a full share of the load on a sliver of
+// mass: its velocity jumped by w F dt / m, that velocity entered the
+// particles' strain through the shape-function gradients, and the particles
+// around a fresh tip chattered at tens of m/s while J went to -1e5 J/m^2
+// (issue 18). Fields of whole material (half a node along a crack, a body
+// edge) are not affected.
+void Solver::spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force) {
   const NodalFields* fields[2] = {&nodes_, &second_};
+  int node[4], field[4];
+  double share[4], total = 0;
+  int count = 0;
+  for_side_nodes(*this, config_.grid, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
+    node[count] = nd;
+    field[count] = f;
+    share[count] = w * std::min(1.0, fields[f]->mass[static_cast<std::size_t>(nd)] / sliver_mass_);
+    total += share[count++];
+  });
+  for (int c = 0; c < count; ++c) {
+    (field[c] ? second_ : nodes_).force[static_cast<std::size_t>(node[c])] += share[c] / total * force;
+  }
+}
+
+void Solver::crack_loads() {
   for (const auto& crack : cracks_) {
     for (std::size_t k = 0; k < crack.size(); ++k) {
       const double p = crack.face_pressure(k);
@@ -102,11 +129,7 @@ void Solver::crack_loads() {
       if (config_.in_situ_reference) t += traction(in_situ_stress(crack.plane()[k]), n);
       if (t.squaredNorm() == 0) continue;
       const Vec2 force = crack.tributary_length(k) * t;
-      for (int side : {1, -1}) {
-        for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
-          (f ? second_ : nodes_).force[static_cast<std::size_t>(nd)] += side * w * force;
-        });
-      }
+      for (int side : {1, -1}) spread_face_force(crack, k, side, side * force);
     }
   }
 }
