@@ -168,6 +168,7 @@ void to_proto(const SideDiagnostics& d, protocol::Diagnostics* out) {
   out->set_front_position(d.front_position);
   out->set_crack_particles(d.crack_particles);
   out->set_fluid_particles(d.fluid_particles);
+  out->set_strain_energy(d.strain_energy);
 }
 
 SideDiagnostics from_proto(const protocol::Diagnostics& d) {
@@ -182,6 +183,7 @@ SideDiagnostics from_proto(const protocol::Diagnostics& d) {
   out.front_position = d.front_position();
   out.crack_particles = d.crack_particles();
   out.fluid_particles = d.fluid_particles();
+  out.strain_energy = d.strain_energy();
   return out;
 }
 

@@ -194,6 +194,18 @@ double Solver::kinetic_energy() const {
   return e;
 }
 
+double Solver::strain_energy() const {
+  double e = 0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const Material& m = config_.materials[static_cast<std::size_t>(particles_.material[p])];
+    const Voigt& s = particles_.stress[p];  // xx, yy, xy, zz
+    const double nu = m.poisson_ratio;
+    const double normal = s[0] * s[0] + s[1] * s[1] + s[3] * s[3] - 2 * nu * (s[0] * s[1] + s[1] * s[3] + s[3] * s[0]);
+    e += particles_.volume[p] * (normal + 2 * (1 + nu) * s[2] * s[2]) / (2 * m.youngs_modulus);
+  }
+  return e;
+}
+
 void Solver::step(double dt) {
   ++epoch_;
   if (cracks_.empty()) {

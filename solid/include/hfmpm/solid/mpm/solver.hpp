@@ -59,6 +59,9 @@ class Solver {
   std::uint64_t steps() const { return steps_; }
   std::uint64_t contacts() const { return contacts_; }  // node contacts applied so far
   double kinetic_energy() const;  // J/m, with the scaled masses
+  // J/m: elastic energy of the particles' stress, sum V sigma : C^-1 : sigma / 2
+  // (of the change from the in-situ state with in_situ_reference).
+  double strain_energy() const;
   const SolidConfig& config() const { return config_; }
   const Grid& grid() const { return config_.grid; }
   Particles& particles() { return particles_; }
