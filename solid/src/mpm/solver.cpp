@@ -67,7 +67,7 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
     total_mass_ += m;
   }
   min_mass_ = 1e-9 * lightest;
-  sliver_mass_ = 0.25 * config_.grid.h * config_.grid.h * *std::min_element(density_.begin(), density_.end());
+  sliver_mass_ = config_.grid.h * config_.grid.h * *std::min_element(density_.begin(), density_.end()) / 64;
 }
 
 // Each cell is filled at one density: the largest particles_per_cell of the

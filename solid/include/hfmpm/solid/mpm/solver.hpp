@@ -25,6 +25,8 @@
 
 namespace hfmpm::solid::mpm {
 
+struct FaceShares;  // solver_cracks.cpp
+
 // The state of one crack tip (fracture.cpp).
 struct TipResult {
   std::size_t crack = 0;
@@ -126,6 +128,7 @@ class Solver {
   // Cracks (solver_cracks.cpp)
   bool near_crack(const Vec2& x) const;
   void crack_loads();
+  FaceShares face_shares(const Crack& crack, std::size_t k, int side) const;
   void spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force);
   void implicit_face_stiffness(double dt);
   void keep_fixed(std::size_t u, int f);
@@ -172,7 +175,7 @@ class Solver {
   std::vector<int> face_slot_;  // scratch of implicit_face_stiffness: node -> entry, -1
   std::uint64_t contacts_ = 0;
   double min_mass_ = 0;  // nodes lighter than this get zero velocity
-  double sliver_mass_ = 0;  // rho h^2 / 4 of the lightest material: lighter fields take less face load
+  double sliver_mass_ = 0;  // rho h^2 / 64 of the lightest material: lighter fields take less face load
 };
 
 }  // namespace hfmpm::solid::mpm
