@@ -54,6 +54,7 @@ RunSummary Coupler::run() {
     stop_sides(false, "end of run");
     summary.ok = true;
     manifest_.set("status", stopped_at_max_steps_ ? "stopped at time.max_steps" : "completed");
+    report_rest();
   } catch (const RunFailure& failure) {
     summary.error = failure.message;
   } catch (const std::exception& e) {
@@ -94,6 +95,18 @@ RunSummary Coupler::run() {
   }
   if (prepared_) manifest_.save();
   return summary;
+}
+
+// A dry run that ends with its solid still moving says so (RestWatch).
+void Coupler::report_rest() {
+  if (!rest_ || !rest_->measured()) return;
+  manifest_.set_number("solid_final_kinetic_energy_j", rest_->mean_kinetic_energy());
+  manifest_.set_number("solid_final_strain_energy_j", rest_->mean_strain_energy());
+  manifest_.set_number("solid_final_kinetic_over_strain_energy", rest_->ratio());
+  if (const auto warning = rest_->warning()) {
+    manifest_.set("warning", *warning);
+    log_("warning: " + *warning);
+  }
 }
 
 void Coupler::prepare() {

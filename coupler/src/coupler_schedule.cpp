@@ -133,6 +133,8 @@ void Coupler::step_loop(RunSummary& summary) {
   if (sides_[1].expected) {
     energy_ = std::make_unique<EnergyWatch>(scene_.coupling().energy_bound());
     energy_->start(sides_[1].diagnostics);
+  } else {
+    rest_ = std::make_unique<RestWatch>(end);
   }
   std::uint64_t frame = 1;
   double next_output = interval;
@@ -187,6 +189,7 @@ void Coupler::step_loop(RunSummary& summary) {
       max_coupling_lag_ = sides_[1].diagnostics.coupling_lag;
       max_coupling_lag_t_ = t_;
     }
+    if (rest_) rest_->update(t_, sides_[0].diagnostics);
     if (energy_) {
       if (auto failure = energy_->update(t_, step_, sides_[0].diagnostics, sides_[1].diagnostics)) {
         history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));

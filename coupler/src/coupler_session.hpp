@@ -88,6 +88,7 @@ class Coupler {
  private:
   // ---------------------------------------------------------------- start
   void prepare();
+  void report_rest();
   std::string program_for(const Side& side) const;
   void launch_sides();
 
@@ -142,6 +143,7 @@ class Coupler {
   std::uint64_t step_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
   std::unique_ptr<EnergyWatch> energy_;
+  std::unique_ptr<RestWatch> rest_;  // dry runs: is the solid at rest at the end?
   double t_ = 0;
 };
 

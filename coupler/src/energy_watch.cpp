@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace hfmpm::coupling {
@@ -36,6 +37,30 @@ std::optional<std::string> EnergyWatch::update(double t, std::uint64_t step, con
       << " m. The coupled step is unstable: exchange every step (coupling.exchange_interval: 1), lower "
          "time.safety_factor or solid.mpm.cfl, or soften the fluid (fluid.mpm.bulk_modulus_pa). A scene whose "
          "tractions do work of their own can raise coupling.energy_bound or set it to 0 (no check).";
+  return out.str();
+}
+
+void RestWatch::update(double t, const SideDiagnostics& solid) {
+  if (t < window_start_) return;
+  kinetic_ += solid.kinetic_energy;
+  strain_ += solid.strain_energy;
+  ++reports_;
+}
+
+double RestWatch::ratio() const {
+  if (!measured()) return 0;
+  return strain_ > 0 ? kinetic_ / strain_ : (kinetic_ > 0 ? std::numeric_limits<double>::infinity() : 0);
+}
+
+std::optional<std::string> RestWatch::warning() const {
+  if (!measured() || !(ratio() > bound_)) return std::nullopt;
+  std::ostringstream out;
+  out << "the solid did not come to rest: over the last tenth of the run (from t = " << window_start_
+      << " s, " << reports_ << " reports) its mean kinetic energy is " << mean_kinetic_energy() << " J/m, "
+      << ratio() << " x its mean strain energy (" << mean_strain_energy() << " J/m; at rest the ratio tends to 0, "
+      << "a freely vibrating body has 1; the bound is " << bound_
+      << "). A quasi-static answer needs more damping or a longer run; particles chattering at a crack "
+         "(docs/solid.md) or a growth that never settles look like this too.";
   return out.str();
 }
 

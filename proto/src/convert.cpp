@@ -169,6 +169,7 @@ void to_proto(const SideDiagnostics& d, protocol::Diagnostics* out) {
   out->set_crack_particles(d.crack_particles);
   out->set_fluid_particles(d.fluid_particles);
   out->set_coupling_lag(d.coupling_lag);
+  out->set_strain_energy(d.strain_energy);
 }
 
 SideDiagnostics from_proto(const protocol::Diagnostics& d) {
@@ -184,6 +185,7 @@ SideDiagnostics from_proto(const protocol::Diagnostics& d) {
   out.crack_particles = d.crack_particles();
   out.fluid_particles = d.fluid_particles();
   out.coupling_lag = d.coupling_lag();
+  out.strain_energy = d.strain_energy();
   return out;
 }
 

@@ -83,6 +83,7 @@ class MpmSolidSide final : public coupling::SideModel {
   SideDiagnostics diagnostics() const override {
     SideDiagnostics d;
     d.kinetic_energy = solver_->kinetic_energy();
+    d.strain_energy = solver_->strain_energy();
     if (!solver_->cracks().empty()) {
       const auto& crack = solver_->cracks().front();
       const auto s = arc_length(crack.plane());

@@ -125,6 +125,21 @@ TEST(InSituStress, HeldByEqualTractionsNothingMoves) {
   expect_held_still(solid);
 }
 
+// Solver::strain_energy (reported to the coupler, which checks that a dry
+// run ends at rest): the in-situ block's uniform stress (sxx, syy, 0, szz)
+// over its area A = 0.5 m^2 stores
+//   A (sxx^2 + syy^2 + szz^2 - 2 nu (sxx syy + syy szz + szz sxx)) / 2E;
+// the particles tile the block, so to round-off.
+TEST(InSituStress, StrainEnergyOfAUniformStress) {
+  Solver solid(block_in_situ());
+  const Material m = rock();
+  const Voigt s = block_in_situ().regions[0].initial_stress;
+  const double nu = m.poisson_ratio;
+  const double exact = 0.5 * (s[0] * s[0] + s[1] * s[1] + s[3] * s[3] - 2 * nu * (s[0] * s[1] + s[1] * s[3] + s[3] * s[0])) /
+                       (2 * m.youngs_modulus);
+  EXPECT_NEAR(solid.strain_energy(), exact, 1e-12 * exact);
+}
+
 // The same with particles of two sizes: one per cell in the block and four
 // (2 x 2) in an inner rectangle whose edges do not lie on cell boundaries
 // (0.23..0.61 x 0.11..0.37 with h = 0.05). Each cell takes the finer density

@@ -120,10 +120,13 @@ double off_line(const std::vector<Vec2>& points, const Vec2& origin, const Vec2&
 // - the two tips' growth counts never differ by more than one step;
 // - the grown parts lie within 2 deg of the crack line (the particles stay
 //   within tan(2 deg) of their distance from the initial tip).
-// Before the fix (face loads spread by linear weights onto node fields of a
-// sliver of mass) the second growth step set the particles at the new tip
-// moving at 20-40 m/s: J/((K_I^2+K_II^2)/E') went to 1.25-2.45, K_II/K_I to
-// 0.26, kinks of +-25 deg.
+// - J after 10 steps (settled) within 5% of a static re-solve of the grown
+//   crack from rest (measured 0.9994, 0.9984).
+// Before the fix (face loads spread by linear weights onto node fields
+// holding only the tail of a particle's weight) the particles at the tip of
+// the second step moved at 20-40 m/s, growth stopped after 3 steps per tip,
+// and at the end J was -2.8e4 / -4.7e4 J/m^2 against K_I = 7.86 / 6.51
+// MPa m^0.5 (2.0 / 1.7 K_Ic) at the two tips, K_II/K_I +0.20 / +0.31.
 TEST(ObliqueGrowth, IsotropicStressGrowsStraightAndSymmetric) {
   const int cells = std::getenv("HFMPM_OBLIQUE_CELLS") ? std::atoi(std::getenv("HFMPM_OBLIQUE_CELLS")) : 5;
   const double h = kA / cells, b = 5 * kA, s0 = -4e6, k_ic = 3.9e6;
@@ -316,8 +319,8 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
   c.fracture.settle_transits = 2;
   c.materials[0].toughness = k_ic * k_ic / kRock.plane_strain_modulus();
   Solver solid(c);
-  constexpr int kSteps = 12;
-  const auto log = grow(solid, [](double) { return 0.0; }, [](int s, int e) { return s >= kSteps && e >= kSteps; },
+  const int kSteps = std::getenv("HFMPM_TENSION_STEPS") ? std::atoi(std::getenv("HFMPM_TENSION_STEPS")) : 12;
+  const auto log = grow(solid, [](double) { return 0.0; }, [&](int s, int e) { return s >= kSteps && e >= kSteps; },
                         80 * transit);
   ASSERT_FALSE(log.empty()) << "the crack never grew";
   EXPECT_GE(log.back().start_grown, kSteps);

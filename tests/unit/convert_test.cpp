@@ -201,6 +201,7 @@ TEST(DiagnosticsConvert, RoundTripIsExact) {
   EXPECT_EQ(plain.crack_particles, 101u);
   EXPECT_EQ(plain.fluid_particles, 77u);
   EXPECT_EQ(plain.coupling_lag, 1.5e3);
+  EXPECT_EQ(plain.strain_energy, 2.5);
   protocol::Diagnostics back;
   hfmpm::proto::to_proto(plain, &back);
   EXPECT_TRUE(MessageDifferencer::Equals(back, message)) << back.ShortDebugString();

@@ -66,3 +66,45 @@ TEST(EnergyWatch, BoundZeroOnlyRecords) {
 
 }  // namespace
 }  // namespace hfmpm::coupling
+
+namespace hfmpm::coupling {
+namespace {
+
+SideDiagnostics solid_energies(double kinetic, double strain) {
+  SideDiagnostics d;
+  d.kinetic_energy = kinetic;
+  d.strain_energy = strain;
+  return d;
+}
+
+// A dry run's end: only the reports of the last tenth of the run count
+// (from t = 9 s of 10 here), averaged; a solid still moving with more than
+// a tenth of its strain energy is named, one at rest is not.
+TEST(RestWatch, WarnsWhenTheSolidEndsMovingAndOnlyThen) {
+  RestWatch moving(10);
+  moving.update(1, solid_energies(1e6, 1));  // before the window: ignored
+  moving.update(9.5, solid_energies(30, 100));
+  moving.update(10, solid_energies(10, 100));
+  ASSERT_TRUE(moving.measured());
+  EXPECT_DOUBLE_EQ(moving.mean_kinetic_energy(), 20);
+  EXPECT_DOUBLE_EQ(moving.mean_strain_energy(), 100);
+  EXPECT_DOUBLE_EQ(moving.ratio(), 0.2);
+  const auto warning = moving.warning();
+  ASSERT_TRUE(warning);
+  EXPECT_NE(warning->find("did not come to rest"), std::string::npos) << *warning;
+  EXPECT_NE(warning->find("0.2 x its mean strain energy"), std::string::npos) << *warning;
+
+  RestWatch resting(10);
+  resting.update(1, solid_energies(1e6, 1));
+  resting.update(10, solid_energies(0.04, 100));
+  EXPECT_FALSE(resting.warning());
+  EXPECT_NEAR(resting.ratio(), 4e-4, 1e-15);
+
+  RestWatch unmeasured(10);
+  unmeasured.update(5, solid_energies(1e6, 1));
+  EXPECT_FALSE(unmeasured.measured());
+  EXPECT_FALSE(unmeasured.warning());
+}
+
+}  // namespace
+}  // namespace hfmpm::coupling

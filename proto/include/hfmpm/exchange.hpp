@@ -46,6 +46,7 @@ struct CrackPressure {
 // Scalars a side reports to the coupler after a StepCommand (history.csv).
 struct SideDiagnostics {
   double kinetic_energy = 0;   // J/m
+  double strain_energy = 0;    // J/m, elastic energy of the solid's stress (of its change with in_situ_reference)
   double crack_length = 0;     // m
   double mouth_opening = 0;    // m
   double crack_face_load = 0;  // N/m

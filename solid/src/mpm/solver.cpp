@@ -67,7 +67,7 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
     total_mass_ += m;
   }
   min_mass_ = 1e-9 * lightest;
-  sliver_mass_ = 0.25 * config_.grid.h * config_.grid.h * *std::min_element(density_.begin(), density_.end());
+  sliver_mass_ = config_.grid.h * config_.grid.h * *std::min_element(density_.begin(), density_.end()) / 64;
 }
 
 // Each cell is filled at one density: the largest particles_per_cell of the
@@ -191,6 +191,18 @@ double Solver::stable_dt() const {
 double Solver::kinetic_energy() const {
   double e = 0;
   for (std::size_t p = 0; p < particles_.size(); ++p) e += 0.5 * particles_.mass[p] * particles_.v[p].squaredNorm();
+  return e;
+}
+
+double Solver::strain_energy() const {
+  double e = 0;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const Material& m = config_.materials[static_cast<std::size_t>(particles_.material[p])];
+    const Voigt& s = particles_.stress[p];  // xx, yy, xy, zz
+    const double nu = m.poisson_ratio;
+    const double normal = s[0] * s[0] + s[1] * s[1] + s[3] * s[3] - 2 * nu * (s[0] * s[1] + s[1] * s[3] + s[3] * s[0]);
+    e += particles_.volume[p] * (normal + 2 * (1 + nu) * s[2] * s[2]) / (2 * m.youngs_modulus);
+  }
   return e;
 }
 

@@ -49,4 +49,34 @@ class EnergyWatch {
   double largest_ = 0, largest_t_ = 0;
 };
 
+// The end-of-run check of a dry run (no fluid): is the solid at rest? Mean
+// kinetic energy against mean strain energy over the last tenth of the run
+// (the reports of that window). A damped, quasi-static run ends with KE a
+// small fraction of its strain energy (the settled growth runs of issue 18:
+// 4e-4); a body vibrating freely has them equal on average; the chatter of
+// issue 18 (particles at a fresh tip moving at 20-40 m/s to the end) had KE
+// several times its strain energy, and the run said "completed". Above
+// `bound` (0.1: a tenth of the elastic energy in motion is no rest) the run
+// says so in run.json and the log. A warning, not a failure: a dry run may be
+// meant to move (waves); the status stays "completed".
+class RestWatch {
+ public:
+  RestWatch(double end_time, double bound = 0.1) : window_start_(0.9 * end_time), bound_(bound) {}
+
+  // After each command: the solid's diagnostics at time t.
+  void update(double t, const SideDiagnostics& solid);
+
+  bool measured() const { return reports_ > 0; }
+  double mean_kinetic_energy() const { return reports_ ? kinetic_ / reports_ : 0; }  // J/m
+  double mean_strain_energy() const { return reports_ ? strain_ / reports_ : 0; }    // J/m
+  double ratio() const;  // mean KE / mean strain energy over the last tenth of the run
+  // The warning's text, or nullopt when the solid ends at rest.
+  std::optional<std::string> warning() const;
+
+ private:
+  double window_start_, bound_;
+  double kinetic_ = 0, strain_ = 0;
+  int reports_ = 0;
+};
+
 }  // namespace hfmpm::coupling

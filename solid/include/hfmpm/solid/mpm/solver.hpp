@@ -25,6 +25,8 @@
 
 namespace hfmpm::solid::mpm {
 
+struct FaceShares;  // solver_cracks.cpp
+
 // The state of one crack tip (fracture.cpp).
 struct TipResult {
   std::size_t crack = 0;
@@ -59,6 +61,9 @@ class Solver {
   std::uint64_t steps() const { return steps_; }
   std::uint64_t contacts() const { return contacts_; }  // node contacts applied so far
   double kinetic_energy() const;  // J/m, with the scaled masses
+  // J/m: elastic energy of the particles' stress, sum V sigma : C^-1 : sigma / 2
+  // (of the change from the in-situ state with in_situ_reference).
+  double strain_energy() const;
   const SolidConfig& config() const { return config_; }
   const Grid& grid() const { return config_.grid; }
   Particles& particles() { return particles_; }
@@ -123,6 +128,7 @@ class Solver {
   // Cracks (solver_cracks.cpp)
   bool near_crack(const Vec2& x) const;
   void crack_loads();
+  FaceShares face_shares(const Crack& crack, std::size_t k, int side) const;
   void spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force);
   void implicit_face_stiffness(double dt);
   void keep_fixed(std::size_t u, int f);
@@ -169,7 +175,7 @@ class Solver {
   std::vector<int> face_slot_;  // scratch of implicit_face_stiffness: node -> entry, -1
   std::uint64_t contacts_ = 0;
   double min_mass_ = 0;  // nodes lighter than this get zero velocity
-  double sliver_mass_ = 0;  // rho h^2 / 4 of the lightest material: lighter fields take less face load
+  double sliver_mass_ = 0;  // rho h^2 / 64 of the lightest material: lighter fields take less face load
 };
 
 }  // namespace hfmpm::solid::mpm
