@@ -11,7 +11,7 @@ namespace hfmpm {
 
 using Vec2 = Eigen::Vector2d;
 
-// What the solid publishes about one crack after a step (DESIGN section 1).
+// What the solid publishes about one crack after a step (docs/protocol.md).
 // Arrays are ordered from the mouth (or one end) to the tip, all of size().
 struct CrackGeometry {
   std::uint32_t crack_id = 0;

@@ -10,8 +10,8 @@
 // where [u] = u_above - u_below is the displacement jump across the crack and
 // n the normal towards the upper face. The second line is the work of the
 // loads on the crack faces inside the domain, which the area integral alone
-// does not see (DESIGN section 2: "J_tip = J - traction work", with the
-// traction work on the faces entering with its sign).
+// does not see (J at the tip is the domain integral less the work of the
+// face tractions, which enters with its sign).
 // Fields are increments from the initial (in-situ) state: displacement
 // gradient grad_u, stress C : sym(grad_u), W = sigma : eps / 2. By
 // superposition the in-situ stress sigma0 then acts as a face load

@@ -65,7 +65,7 @@ struct FluidConfig {
   // stays in the fluid.
   double virtual_opening = 0;
   // Pressure on the crack between the fluid front and the tip (the lag):
-  // Zero (vapour pressure, DESIGN.md 3), or Front: the first crack node
+  // Zero (vapour pressure), or Front: the first crack node
   // beyond the front carries the pressure of the fluid at the front, at most
   // the mouth's (the fluid flows towards the
   // tip; the last particle, compressed against the closed tip, can carry

@@ -1,6 +1,6 @@
 // The fluid's grid: the crack particles of one crack, ordered from the mouth
 // (node 0) to the tip, with the 1D coordinate s = arc length along the crack
-// polyline (DESIGN.md 3). The solid publishes it after every step, so the grid
+// polyline (docs/fluid.md). The solid publishes it after every step, so the grid
 // moves and stretches with the solid; fictitious forces from curvature and
 // stretching are ignored. Fluid particles keep their arc length when the grid
 // moves (they are not convected with the crack particles).

@@ -1,4 +1,4 @@
-// Tait equation of state of a weakly compressible liquid (water), DESIGN.md 3:
+// Tait equation of state of a weakly compressible liquid (water), docs/fluid.md:
 //   p(J) = c K (exp((1 - J) / c) - 1),   c = 0.0894 for water,
 // J = V / V0 the volume ratio (V0 the volume at zero pressure). With the "-1"
 // the reference state is unloaded, p(1) = 0, and dp/dJ(1) = -K, so K is the

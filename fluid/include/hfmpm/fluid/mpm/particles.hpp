@@ -3,7 +3,7 @@
 // particle p occupies [s_p - l_p/2, s_p + l_p/2], the end of one is the start
 // of the next, and particle 0 starts at the mouth (it is the inlet particle).
 //
-// Deformation gradient with two components (DESIGN.md 3):
+// Deformation gradient with two components (docs/fluid.md):
 //   F11 stretch along the crack, F11 = l / l0 (l0 the length on entry);
 //   F22 = w / w0, w the crack width averaged over the particle's domain and w0
 //       the width on entry.

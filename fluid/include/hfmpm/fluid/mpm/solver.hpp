@@ -1,4 +1,4 @@
-// 1D MPM of the fluid in one crack (nested-manifold MPM, DESIGN.md 3).
+// 1D MPM of the fluid in one crack (nested-manifold MPM, docs/fluid.md).
 //
 // Momentum balance. Width-averaged (lubrication) flow in a channel of opening
 // w(s), per unit thickness and per unit length along the crack:
@@ -34,7 +34,7 @@
 //      corner update), so neighbours stay contiguous;
 //      F11 <- F11 l^{n+1} / l^n = (1 + Gbar v dt) F11 with Gbar v = dv/ds the
 //      CPDI velocity gradient: the same to first order in dt as
-//      exp(dv/ds dt) F11 (DESIGN.md 3), but consistent with the moved ends;
+//      exp(dv/ds dt) F11, but consistent with the moved ends;
 //      with the exponential and l = l0 F11, the ends of neighbours would drift
 //      apart, opening gaps and overlaps between particles;
 //   5. inlet (and outlet): the inlet particle is re-extended to the mouth and
@@ -107,7 +107,7 @@ class FluidSolver {
   // crack opens there (the fluid's tangent bulk modulus K_t J over the width;
   // 0 where the pressure does not follow the width). The solid uses it to
   // treat the pressure's change over its own step implicitly (the explicit
-  // coupling of a stiff fluid is otherwise unstable: DESIGN.md 3, docs/fluid.md).
+  // coupling of a stiff fluid is otherwise unstable: docs/fluid.md, docs/solid.md).
   std::vector<double> nodal_stiffness() const;  // computed when called (once per exchange)
   CrackPressure pressure_message() const;
   // Pa, the largest change of a wetted node's pressure since the last
