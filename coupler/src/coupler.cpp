@@ -19,7 +19,9 @@ RunSummary run_coupled(const scene::Scene& scene, const RunOptions& options) {
 namespace detail {
 
 Coupler::Coupler(const scene::Scene& scene, const RunOptions& options)
-    : scene_(scene), options_(options), router_(*context_, zmq::socket_type::router),
+    : scene_(scene),
+      options_(options),
+      router_(*context_, zmq::socket_type::router),
       progress_(options.progress, scene.time().end_s()) {
   sides_[0].role = protocol::SOLID;
   sides_[0].name = "solid";
@@ -170,8 +172,8 @@ void Coupler::prepare() {
     // Printed even when quiet: the person starting the sides needs the endpoint.
     std::string reachable = control_endpoint_;
     if (tcp_host(reachable) == "0.0.0.0") reachable = advertise(reachable, host_name());
-    const std::string line = "waiting for sides at " + control_endpoint_ + " (start each with --connect " +
-                             reachable + ")";
+    const std::string line =
+        "waiting for sides at " + control_endpoint_ + " (start each with --connect " + reachable + ")";
     std::cerr << "hfmpm: " << line << std::endl;
     log_.file_only(line);
   }
@@ -201,7 +203,8 @@ void Coupler::launch_sides() {
       side_options.control_endpoint = control_endpoint_;
       side_options.implementation = std::string("in-process ") + side.name;
       side_options.context = context_.get();
-      side.thread = std::thread([model, side_options, exit = side.thread_exit] { *exit = run_side(*model, side_options); });
+      side.thread =
+          std::thread([model, side_options, exit = side.thread_exit] { *exit = run_side(*model, side_options); });
       manifest_.set(side.name + "_program", "in-process thread");
       continue;
     }

@@ -35,8 +35,8 @@ void Coupler::handshake() {
   // prove the sides alive meanwhile, so this limit can be generous.
   Side& solid = sides_[0];
   Side& fluid = sides_[1];
-  protocol::Envelope welcome = welcome_for(fluid.expected ? protocol::DataPlane::BIND : protocol::DataPlane::NONE,
-                                           data_bind_);
+  protocol::Envelope welcome =
+      welcome_for(fluid.expected ? protocol::DataPlane::BIND : protocol::DataPlane::NONE, data_bind_);
   send_to(solid, welcome);
   if (fluid.expected) {
     wait_until([](const Side& s) { return s.role == protocol::SOLID && s.data_endpoint.empty(); },
@@ -64,11 +64,11 @@ void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelop
   if (!side.joined) {
     if (!envelope.has_hello()) unexpected(side, envelope, "Hello");
     const auto& hello = envelope.hello();
-    const std::string who = "the " + side.name + " side (" + hello.implementation() + " " +
-                            hello.implementation_version() + ")";
+    const std::string who =
+        "the " + side.name + " side (" + hello.implementation() + " " + hello.implementation_version() + ")";
     if (hello.role() != side.role) {
-      reject(side, who + " connected as '" + side.name + "' but says it is " +
-                       std::string(proto::role_name(hello.role())));
+      reject(side,
+             who + " connected as '" + side.name + "' but says it is " + std::string(proto::role_name(hello.role())));
     }
     if (hello.protocol_version() != proto::kProtocolVersion) {
       reject(side, who + " speaks protocol version " + std::to_string(hello.protocol_version()) +
@@ -112,8 +112,8 @@ double Coupler::next_dt() {
   for (const auto& side : sides_) {
     if (!side.expected) continue;
     if (std::isnan(side.stable_dt) || side.stable_dt <= 0) {
-      throw RunFailure{"the " + side.name + " side reported a stable time step of " +
-                       std::to_string(side.stable_dt) + " s" + at_step() + "; it must be > 0"};
+      throw RunFailure{"the " + side.name + " side reported a stable time step of " + std::to_string(side.stable_dt) +
+                       " s" + at_step() + "; it must be > 0"};
     }
     stable = std::min(stable, side.stable_dt);
   }
@@ -229,8 +229,8 @@ void Coupler::await_reports(std::uint64_t step, double t, double timeout_s) {
     const auto& report = envelope.step_report();
     if (report.step() != step || report.t() != t) {
       std::ostringstream out;
-      out << std::setprecision(17) << "the " << side->name << " side reports step " << report.step() << " at t = " << report.t()
-          << " s, but step " << step << " at t = " << t << " s was commanded";
+      out << std::setprecision(17) << "the " << side->name << " side reports step " << report.step()
+          << " at t = " << report.t() << " s, but step " << step << " at t = " << t << " s was commanded";
       throw RunFailure{out.str()};
     }
     side->report = report;

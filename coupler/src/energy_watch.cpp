@@ -28,12 +28,11 @@ std::optional<std::string> EnergyWatch::update(double t, std::uint64_t step, con
   if (bound_ <= 0 || !(ratio > bound_)) return std::nullopt;
   std::ostringstream out;
   out << "energy is being created: at step " << step << " (t = " << t << " s) the solid's kinetic energy is "
-      << solid.kinetic_energy << " J/m, " << ratio << " x the energy the fluid can have given it ("
-      << available << " J/m: " << work_ << " J/m of inlet work and " << e0_
-      << " J/m for the initial fill, p0 V0; the bound is " << bound_
-      << " x, coupling.energy_bound). The inlet pressure is "
-      << fluid.inlet_pressure << " Pa, the fluid volume " << fluid.fluid_volume << " m^2 against "
-      << fluid.injected_volume << " m^2 injected, the mouth opening " << solid.mouth_opening
+      << solid.kinetic_energy << " J/m, " << ratio << " x the energy the fluid can have given it (" << available
+      << " J/m: " << work_ << " J/m of inlet work and " << e0_ << " J/m for the initial fill, p0 V0; the bound is "
+      << bound_ << " x, coupling.energy_bound). The inlet pressure is " << fluid.inlet_pressure
+      << " Pa, the fluid volume " << fluid.fluid_volume << " m^2 against " << fluid.injected_volume
+      << " m^2 injected, the mouth opening " << solid.mouth_opening
       << " m. The coupled step is unstable: exchange every step (coupling.exchange_interval: 1), lower "
          "time.safety_factor or solid.mpm.cfl, or soften the fluid (fluid.mpm.bulk_modulus_pa). A scene whose "
          "tractions do work of their own can raise coupling.energy_bound or set it to 0 (no check).";
@@ -55,9 +54,9 @@ double RestWatch::ratio() const {
 std::optional<std::string> RestWatch::warning() const {
   if (!measured() || !(ratio() > bound_)) return std::nullopt;
   std::ostringstream out;
-  out << "the solid did not come to rest: over the last tenth of the run (from t = " << window_start_
-      << " s, " << reports_ << " reports) its mean kinetic energy is " << mean_kinetic_energy() << " J/m, "
-      << ratio() << " x its mean strain energy (" << mean_strain_energy() << " J/m; at rest the ratio tends to 0, "
+  out << "the solid did not come to rest: over the last tenth of the run (from t = " << window_start_ << " s, "
+      << reports_ << " reports) its mean kinetic energy is " << mean_kinetic_energy() << " J/m, " << ratio()
+      << " x its mean strain energy (" << mean_strain_energy() << " J/m; at rest the ratio tends to 0, "
       << "a freely vibrating body has 1; the bound is " << bound_
       << "). A quasi-static answer needs more damping or a longer run; particles chattering at a crack "
          "(docs/solid.md) or a growth that never settles look like this too.";

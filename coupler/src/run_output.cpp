@@ -16,12 +16,13 @@ History::History(const std::string& path) : out_(path) {
   out_ << std::setprecision(10);
   // The first nine columns are the ones every hfmpm history has (docs/architecture.md, "history.csv").
   out_ << "time_s,step,crack_length_m,mouth_opening_m,inlet_pressure_pa,injected_volume_m2,fluid_volume_m2,"
-          "kinetic_energy_j,wall_s,dt_s,crack_face_load_n_per_m,front_position_m,crack_particles,fluid_particles,coupling_lag_pa\n";
+          "kinetic_energy_j,wall_s,dt_s,crack_face_load_n_per_m,front_position_m,crack_particles,fluid_particles,"
+          "coupling_lag_pa\n";
   out_.flush();
 }
 
-void History::write(double t, std::uint64_t step, double dt, const SideDiagnostics& solid,
-                    const SideDiagnostics& fluid, double wall_s) {
+void History::write(double t, std::uint64_t step, double dt, const SideDiagnostics& solid, const SideDiagnostics& fluid,
+                    double wall_s) {
   out_ << t << ',' << step << ',' << solid.crack_length << ',' << solid.mouth_opening << ',' << fluid.inlet_pressure
        << ',' << fluid.injected_volume << ',' << fluid.fluid_volume << ',' << solid.kinetic_energy << ',' << wall_s
        << ',' << dt << ',' << solid.crack_face_load << ',' << fluid.front_position << ',' << solid.crack_particles

@@ -101,8 +101,9 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
     out.normal[k] = Vec2(crack.nx(i), crack.ny(i));
     out.tip[k] = crack.tip(i) ? 1 : 0;
     if (std::abs(out.normal[k].norm() - 1.0) > 1e-6) {
-      fail(type, id, "normal " + std::to_string(i) + " has length " + std::to_string(out.normal[k].norm()) +
-                         "; normals must be unit vectors");
+      fail(type, id,
+           "normal " + std::to_string(i) + " has length " + std::to_string(out.normal[k].norm()) +
+               "; normals must be unit vectors");
     }
     if (out.width[k] < 0) {
       fail(type, id, "width[" + std::to_string(i) + "] = " + std::to_string(out.width[k]) + " m; widths are >= 0");

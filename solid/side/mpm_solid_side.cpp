@@ -1,12 +1,12 @@
 #include "mpm_solid_side.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <optional>
 
-#include "hfmpm/proto/convert.hpp"
 #include "hfmpm/output/frame_writer.hpp"
+#include "hfmpm/proto/convert.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
 
 namespace hfmpm::solid {
@@ -17,10 +17,14 @@ Vec2 hi(const scene::Box& b) { return {b.x_max_m(), b.y_max_m()}; }
 
 mpm::Edge to_edge(scene::Edge e) {
   switch (e) {
-    case scene::RIGHT: return mpm::Edge::Right;
-    case scene::BOTTOM: return mpm::Edge::Bottom;
-    case scene::TOP: return mpm::Edge::Top;
-    default: return mpm::Edge::Left;
+    case scene::RIGHT:
+      return mpm::Edge::Right;
+    case scene::BOTTOM:
+      return mpm::Edge::Bottom;
+    case scene::TOP:
+      return mpm::Edge::Top;
+    default:
+      return mpm::Edge::Left;
   }
 }
 
@@ -89,7 +93,8 @@ class MpmSolidSide final : public coupling::SideModel {
       const auto s = arc_length(crack.plane());
       d.crack_length = s.back();
       d.mouth_opening = crack.width(0);
-      for (std::size_t k = 0; k < crack.size(); ++k) d.crack_face_load += crack.face_pressure(k) * crack.tributary_length(k);
+      for (std::size_t k = 0; k < crack.size(); ++k)
+        d.crack_face_load += crack.face_pressure(k) * crack.tributary_length(k);
     }
     for (const auto& crack : solver_->cracks()) d.crack_particles += static_cast<std::uint32_t>(crack.size());
     return d;
@@ -195,7 +200,8 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
       region.hi = hi(r.rectangle());
     } else if (r.has_polygon()) {
       region.kind = mpm::Region::Kind::Polygon;
-      for (int i = 0; i < r.polygon().x_m_size(); ++i) region.polygon.emplace_back(r.polygon().x_m(i), r.polygon().y_m(i));
+      for (int i = 0; i < r.polygon().x_m_size(); ++i)
+        region.polygon.emplace_back(r.polygon().x_m(i), r.polygon().y_m(i));
     } else {
       region.kind = mpm::Region::Kind::Layer;
       region.lo = Vec2(0, r.layer().y_min_m());
@@ -203,8 +209,8 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
     }
     const auto& st = r.initial_stress();
     const double nu = c.materials[static_cast<std::size_t>(region.material)].poisson_ratio;
-    region.initial_stress = mpm::Voigt(st.xx_pa(), st.yy_pa(), st.xy_pa(),
-                                       st.has_zz_pa() ? st.zz_pa() : nu * (st.xx_pa() + st.yy_pa()));
+    region.initial_stress =
+        mpm::Voigt(st.xx_pa(), st.yy_pa(), st.xy_pa(), st.has_zz_pa() ? st.zz_pa() : nu * (st.xx_pa() + st.yy_pa()));
     if (r.has_particles_per_cell()) region.particles_per_cell = static_cast<int>(r.particles_per_cell());
     c.regions.push_back(region);
   }

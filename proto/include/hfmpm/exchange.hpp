@@ -36,9 +36,9 @@ struct CrackPressure {
   // treats the change over its step implicitly.
   std::vector<double> stiffness;
   std::vector<double> width;
-  double front_position = 0;       // m, arc length from the mouth
-  double inlet_flux = 0;           // m^2/s
-  double fluid_volume = 0;         // m^2
+  double front_position = 0;  // m, arc length from the mouth
+  double inlet_flux = 0;      // m^2/s
+  double fluid_volume = 0;    // m^2
 
   std::size_t size() const { return ids.size(); }
 };

@@ -13,10 +13,14 @@ namespace {
 
 Vec2 outward_normal(Edge edge) {
   switch (edge) {
-    case Edge::Left: return {-1, 0};
-    case Edge::Right: return {1, 0};
-    case Edge::Bottom: return {0, -1};
-    case Edge::Top: return {0, 1};
+    case Edge::Left:
+      return {-1, 0};
+    case Edge::Right:
+      return {1, 0};
+    case Edge::Bottom:
+      return {0, -1};
+    case Edge::Top:
+      return {0, 1};
   }
   return {0, 0};
 }
@@ -184,7 +188,8 @@ void Solver::find_edges() {
 
 double Solver::stable_dt() const {
   double fastest = 0;
-  for (std::size_t m = 0; m < p_modulus_.size(); ++m) fastest = std::max(fastest, std::sqrt(p_modulus_[m] / density_[m]));
+  for (std::size_t m = 0; m < p_modulus_.size(); ++m)
+    fastest = std::max(fastest, std::sqrt(p_modulus_[m] / density_[m]));
   return config_.cfl * config_.grid.h / fastest;
 }
 
@@ -378,8 +383,7 @@ bool Region::contains(const Vec2& p) const {
       for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
         const Vec2& a = polygon[i];
         const Vec2& b = polygon[j];
-        if ((a.y() > p.y()) != (b.y() > p.y()) &&
-            p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+        if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
           inside = !inside;
         }
       }

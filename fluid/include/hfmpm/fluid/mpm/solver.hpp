@@ -161,7 +161,7 @@ class FluidSolver {
   ShapeTable shapes_;
   // nodal fields
   std::vector<double> mass_, momentum_, drag_, force_, v_old_, v_new_, nodal_pressure_;
-  std::vector<double> pressure_at_set_;  // Pa per node, right after the last set_crack
+  std::vector<double> pressure_at_set_;        // Pa per node, right after the last set_crack
   std::vector<double> drag_k_, widths_floor_;  // scratch per particle
   double particle_length_ = 0;                 // m, resolved target length
   double t_ = 0;

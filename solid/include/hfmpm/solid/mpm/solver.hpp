@@ -33,13 +33,13 @@ struct TipResult {
   bool at_end = true;              // the crack's last particle (false: its first)
   Vec2 position = Vec2::Zero();    // m
   Vec2 direction = Vec2::UnitX();  // unit, along the last segment, out of the crack
-  double j = 0;          // J/m^2: energy release rate (area integral plus face-load work)
-  double j_faces = 0;    // J/m^2: the face-load part of j
-  double k1 = 0, k2 = 0; // Pa m^0.5, from the interaction integral (Williams auxiliary fields)
-  double kink = 0;       // rad, growth direction by maximum hoop stress, counter-clockwise from direction
-  double toughness = 0;  // J/m^2, J_Ic of the material at the tip
-  double modulus = 0;    // Pa, plane-strain E' there
-  std::size_t material = 0;  // index of the material at the tip
+  double j = 0;                    // J/m^2: energy release rate (area integral plus face-load work)
+  double j_faces = 0;              // J/m^2: the face-load part of j
+  double k1 = 0, k2 = 0;           // Pa m^0.5, from the interaction integral (Williams auxiliary fields)
+  double kink = 0;                 // rad, growth direction by maximum hoop stress, counter-clockwise from direction
+  double toughness = 0;            // J/m^2, J_Ic of the material at the tip
+  double modulus = 0;              // Pa, plane-strain E' there
+  std::size_t material = 0;        // index of the material at the tip
 };
 
 // J/m^2: the energy release rate that drives growth, J without the share of
@@ -60,7 +60,7 @@ class Solver {
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
   std::uint64_t contacts() const { return contacts_; }  // node contacts applied so far
-  double kinetic_energy() const;  // J/m, with the scaled masses
+  double kinetic_energy() const;                        // J/m, with the scaled masses
   // J/m: elastic energy of the particles' stress, sum V sigma : C^-1 : sigma / 2
   // (of the change from the in-situ state with in_situ_reference).
   double strain_energy() const;
@@ -81,9 +81,7 @@ class Solver {
   // accelerations, P2G's per-thread accumulators (for memory reports).
   std::size_t grid_bytes() const;
   // Particles on each edge of the body (Left, Right, Bottom, Top), found once.
-  const std::vector<std::uint32_t>& edge_particles(Edge edge) const {
-    return edges_[static_cast<std::size_t>(edge)];
-  }
+  const std::vector<std::uint32_t>& edge_particles(Edge edge) const { return edges_[static_cast<std::size_t>(edge)]; }
   std::vector<Crack>& cracks() { return cracks_; }
   const std::vector<Crack>& cracks() const { return cracks_; }
   // The nodal fields of one side of a crack: field 1 holds the particles whose
@@ -96,8 +94,8 @@ class Solver {
   // crack; the rest get 0). Optionally the fluid's stiffness -dp/dw (Pa/m)
   // and the widths (m) the pressure was computed from (both the pressure's
   // size, or empty): the faces then carry p - stiffness (w - width).
-  void set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
-                          const std::vector<double>& stiffness = {}, const std::vector<double>& width = {});
+  void set_crack_pressure(std::size_t c, const std::vector<double>& pressure, const std::vector<double>& stiffness = {},
+                          const std::vector<double>& width = {});
   // The fluid front on crack c: arc length (m) from its first particle.
   void set_crack_front(std::size_t c, double arc_length);
 
@@ -148,8 +146,8 @@ class Solver {
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
   Particles particles_;
-  NodalFields nodes_;                 // reduced fields, field 0
-  NodalFields second_;                // field 1 (other side of a crack); sized only with cracks
+  NodalFields nodes_;   // reduced fields, field 0
+  NodalFields second_;  // field 1 (other side of a crack); sized only with cracks
   std::vector<Crack> cracks_;
   // P2G's per-thread accumulators: one cache line per node and field
   // (index node * fields + field), over the span of nodes the thread's
@@ -165,8 +163,8 @@ class Solver {
   std::vector<std::uint16_t> sides_;
   std::vector<std::uint32_t> stamp_;
   std::vector<int> active_;
-  std::vector<Vec2> velocity_[2];     // new nodal velocity, per field and node
-  std::vector<Vec2> acceleration_[2]; // nodal acceleration, per field and node
+  std::vector<Vec2> velocity_[2];      // new nodal velocity, per field and node
+  std::vector<Vec2> acceleration_[2];  // nodal acceleration, per field and node
   std::vector<std::uint32_t> edges_[4];
   std::vector<double> lambda_, shear_, p_modulus_, density_;  // per material, density scaled
   std::uint32_t epoch_ = 0;
@@ -174,7 +172,7 @@ class Solver {
   std::uint64_t steps_ = 0;
   std::vector<int> face_slot_;  // scratch of implicit_face_stiffness: node -> entry, -1
   std::uint64_t contacts_ = 0;
-  double min_mass_ = 0;  // nodes lighter than this get zero velocity
+  double min_mass_ = 0;     // nodes lighter than this get zero velocity
   double sliver_mass_ = 0;  // rho h^2 / 64 of the lightest material: lighter fields take less face load
 };
 
