@@ -31,6 +31,31 @@ inline void settle(Solver& solid, double length, double transits) {
   while (solid.time() < end) solid.step(dt);
 }
 
+// The plate [-b, b]^2 of kRock (grid two cells wider on each side) with a
+// straight interior crack of length 2a at `angle` to the x axis centred at
+// `centre`, both ends tips, crack particles every half cell; critically
+// damped for the plate's lowest mode. Loads and stresses are the caller's.
+inline SolidConfig plate_with_centre_crack(double h, double b, double a, double angle, const Vec2& centre) {
+  SolidConfig c;
+  c.grid.origin = Vec2(-b - 2 * h, -b - 2 * h);
+  c.grid.h = h;
+  c.grid.nx = c.grid.ny = static_cast<int>(std::lround(2 * b / h)) + 4;
+  c.materials = {kRock};
+  Region r;
+  r.lo = Vec2(-b, -b);
+  r.hi = Vec2(b, b);
+  c.regions = {r};
+  CrackSpec crack;
+  const int segments = static_cast<int>(std::lround(4 * a / h));
+  const Vec2 dir(std::cos(angle), std::sin(angle));
+  for (int k = 0; k <= segments; ++k) crack.points.push_back(centre + (-a + 2 * a * k / segments) * dir);
+  crack.start_is_tip = true;
+  crack.end_is_tip = true;
+  c.cracks = {crack};
+  c.damping.grid_alpha = critical_alpha(2 * b);
+  return c;
+}
+
 // Strip [0, W] x [-H, H] with an edge crack from (0, 0) to (a, 0) along a grid
 // line, pulled by sigma(t) on the top and bottom edges.
 inline SolidConfig edge_crack(double w, double a, double half_height, int cells_across, TimeFunction sigma) {

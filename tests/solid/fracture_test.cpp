@@ -34,9 +34,10 @@ TEST(EdgeCrack, StressIntensityFromJMatchesTada) {
     const auto tips = solid.tips();
     ASSERT_EQ(tips.size(), 1u);
     const double error = (tips[0].k1 - k_exact) / k_exact;
-    std::printf("edge crack a/W = 0.3, h = W/%d: K_I %.4e Pa m^0.5, Tada %.4e, error %+.4f, "
-                "|K_II|/K_I %.1e, face work %.3f of J\n",
-                cells, tips[0].k1, k_exact, error, std::abs(tips[0].k2) / tips[0].k1, tips[0].j_faces / tips[0].j);
+    std::printf(
+        "edge crack a/W = 0.3, h = W/%d: K_I %.4e Pa m^0.5, Tada %.4e, error %+.4f, "
+        "|K_II|/K_I %.1e, face work %.3f of J\n",
+        cells, tips[0].k1, k_exact, error, std::abs(tips[0].k2) / tips[0].k1, tips[0].j_faces / tips[0].j);
     EXPECT_LT(std::abs(error), cells >= 40 ? 0.03 : 0.05);
     EXPECT_LT(std::abs(tips[0].k2), 1e-6 * tips[0].k1) << "mode I problem with a mode II part";
     EXPECT_LE(std::abs(error), previous + 0.005) << "K does not improve with refinement";
@@ -123,25 +124,9 @@ constexpr double kA = 1, kB = 10, kSigma = 1e6;
 // The centre crack of length 2 kA at 45 degrees in the plate [-kB, kB]^2 pulled by
 // kSigma on its top and bottom edges; crack particles every half cell.
 SolidConfig inclined_crack(double h) {
-  SolidConfig c;
-  c.grid.origin = Vec2(-kB - 2 * h, -kB - 2 * h);
-  c.grid.h = h;
-  c.grid.nx = c.grid.ny = static_cast<int>(std::lround(2 * kB / h)) + 4;
-  c.materials = {kRock};
-  Region r;
-  r.lo = Vec2(-kB, -kB);
-  r.hi = Vec2(kB, kB);
-  c.regions = {r};
+  SolidConfig c = plate_with_centre_crack(h, kB, kA, kPi / 4, Vec2::Zero());
   const auto sigma = TimeFunction::constant(kSigma);
   c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
-  CrackSpec crack;
-  const int segments = static_cast<int>(std::lround(4 * kA / h));
-  const Vec2 dir(std::cos(kPi / 4), std::sin(kPi / 4));
-  for (int k = 0; k <= segments; ++k) crack.points.push_back((-kA + 2 * kA * k / segments) * dir);
-  crack.start_is_tip = true;
-  crack.end_is_tip = true;
-  c.cracks = {crack};
-  c.damping.grid_alpha = critical_alpha(2 * kB);
   c.threads = 2;
   return c;
 }
@@ -187,10 +172,11 @@ TEST(InclinedCrack, MixedModeAndKinkAngle) {
     const auto tips = wide_domain ? probe.tips() : solid.tips();
     ASSERT_EQ(tips.size(), 2u);
     for (const auto& tip : tips) {
-      std::printf("inclined crack h = a/%d, domain %s, %s tip: K_I %.4e (error %+.4f), K_II %.4e (error %+.4f), "
-                  "kink %.2f deg (exact %.2f)\n",
-                  cells, wide_domain ? "3-7" : "2-5", tip.at_end ? "end" : "start", tip.k1, tip.k1 / k_exact - 1,
-                  tip.k2, tip.k2 / k_exact - 1, tip.kink * 180 / kPi, kink_exact * 180 / kPi);
+      std::printf(
+          "inclined crack h = a/%d, domain %s, %s tip: K_I %.4e (error %+.4f), K_II %.4e (error %+.4f), "
+          "kink %.2f deg (exact %.2f)\n",
+          cells, wide_domain ? "3-7" : "2-5", tip.at_end ? "end" : "start", tip.k1, tip.k1 / k_exact - 1, tip.k2,
+          tip.k2 / k_exact - 1, tip.kink * 180 / kPi, kink_exact * 180 / kPi);
       const double tolerance = wide_domain ? 0.05 : 0.08;
       EXPECT_NEAR(tip.k1 / k_exact, 1, tolerance);
       EXPECT_NEAR(tip.k2 / k_exact, 1, tolerance);
@@ -229,16 +215,16 @@ TEST(InclinedCrack, ASecondKinkDoesNotRepeatTheFirst) {
   solid.cracks()[0].append(first.position + 0.5 * h * Vec2(std::cos(first_heading), std::sin(first_heading)));
   const TipResult second = end_tip();
   const double second_heading = heading(second);
-  std::printf("kink %.2f deg from the crack (heading %.2f deg); after it, the next heading %.2f deg (kink %.2f deg "
-              "from the tip frame at %.2f deg)\n",
-              first.kink * 180 / kPi, first_heading * 180 / kPi, second_heading * 180 / kPi, second.kink * 180 / kPi,
-              std::atan2(second.direction.y(), second.direction.x()) * 180 / kPi);
+  std::printf(
+      "kink %.2f deg from the crack (heading %.2f deg); after it, the next heading %.2f deg (kink %.2f deg "
+      "from the tip frame at %.2f deg)\n",
+      first.kink * 180 / kPi, first_heading * 180 / kPi, second_heading * 180 / kPi, second.kink * 180 / kPi,
+      std::atan2(second.direction.y(), second.direction.x()) * 180 / kPi);
   EXPECT_NEAR(second_heading * 180 / kPi, first_heading * 180 / kPi, 10);
 }
 
 }  // namespace
 }  // namespace hfmpm::solid::mpm
-
 
 namespace hfmpm::solid::mpm {
 namespace {
@@ -250,7 +236,7 @@ template <class T>
 std::array<T, 2> williams_displacement(T x1, T x2, double k1, double k2, double mu, double kappa) {
   using std::sqrt;
   const T r = sqrt(x1 * x1 + x2 * x2);
-  const T c = sqrt((r + x1) / (2.0 * r));                                   // cos(theta / 2)
+  const T c = sqrt((r + x1) / (2.0 * r));                                     // cos(theta / 2)
   const T s = (std::real(x2) < 0 ? -1.0 : 1.0) * sqrt((r - x1) / (2.0 * r));  // sin(theta / 2)
   const T g = sqrt(r / (2 * kPi)) / (2 * mu);
   return {g * (k1 * c * (kappa - 1 + 2.0 * s * s) + k2 * s * (kappa + 1 + 2.0 * c * c)),
@@ -328,10 +314,11 @@ TEST(InteractionIntegral, RecoversPrescribedWilliamsField) {
     ASSERT_NEAR((tip.position - tip_position).norm(), 0, 1e-12);
     const double k1_kink = std::max(0.0, k1);
     const double kink = k2 == 0 ? 0 : 2 * std::atan((k1_kink - std::sqrt(k1_kink * k1_kink + 8 * k2 * k2)) / (4 * k2));
-    std::printf("prescribed K_I %+.2e, K_II %+.2e: returned K_I %+.6e, K_II %+.6e, (K_I K_I' + K_II K_II') / E' J - 1 "
-                "= %.1e, kink %.3f deg (exact %.3f)\n",
-                k1, k2, tip.k1, tip.k2, (k1 * tip.k1 + k2 * tip.k2) / (e_prime * tip.j) - 1, tip.kink * 180 / kPi,
-                kink * 180 / kPi);
+    std::printf(
+        "prescribed K_I %+.2e, K_II %+.2e: returned K_I %+.6e, K_II %+.6e, (K_I K_I' + K_II K_II') / E' J - 1 "
+        "= %.1e, kink %.3f deg (exact %.3f)\n",
+        k1, k2, tip.k1, tip.k2, (k1 * tip.k1 + k2 * tip.k2) / (e_prime * tip.j) - 1, tip.kink * 180 / kPi,
+        kink * 180 / kPi);
     EXPECT_NEAR((k1 * tip.k1 + k2 * tip.k2) / (e_prime * tip.j), 1, 1e-10);
     EXPECT_NEAR(tip.k1 / k0, k1 / k0, 0.005);
     EXPECT_NEAR(tip.k2 / k0, k2 / k0, 0.005);

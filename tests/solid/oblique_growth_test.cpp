@@ -19,32 +19,27 @@ constexpr double kA = 1;  // m, half-length of the initial crack
 
 // An interior crack of length 2 kA at `angle` to the x axis with its centre
 // at `centre`, in the plate [-b, b]^2 under the in-situ stress (sxx, syy)
-// held by the edges, as the reference state; crack particles every half cell.
-SolidConfig oblique_crack(double h, double b, double angle, const Vec2& centre, double sxx, double syy) {
-  SolidConfig c;
-  c.grid.origin = Vec2(-b - 2 * h, -b - 2 * h);
-  c.grid.h = h;
-  c.grid.nx = c.grid.ny = static_cast<int>(std::lround(2 * b / h)) + 4;
-  c.materials = {kRock};
-  Region r;
-  r.lo = Vec2(-b, -b);
-  r.hi = Vec2(b, b);
-  r.initial_stress = Voigt(sxx, syy, 0, kRock.poisson_ratio * (sxx + syy));
-  c.regions = {r};
+// held by the edges, as the reference state; crack particles every half
+// cell. It grows by quarter cells when its tips reach K_Ic = k_ic (J domain
+// 3-7 cells, settle_transits 2).
+SolidConfig oblique_crack(double h, double b, double angle, const Vec2& centre, double sxx, double syy, double k_ic) {
+  SolidConfig c = plate_with_centre_crack(h, b, kA, angle, centre);
+  c.regions[0].initial_stress = Voigt(sxx, syy, 0, kRock.poisson_ratio * (sxx + syy));
   c.in_situ_reference = true;
   auto held = [](Edge e, double s) { return Traction{e, TimeFunction::constant(s), TimeFunction::constant(0)}; };
   c.tractions = {held(Edge::Left, sxx), held(Edge::Right, sxx), held(Edge::Bottom, syy), held(Edge::Top, syy)};
-  CrackSpec crack;
-  const int segments = static_cast<int>(std::lround(4 * kA / h));
-  const Vec2 dir(std::cos(angle), std::sin(angle));
-  for (int k = 0; k <= segments; ++k) crack.points.push_back(centre + (-kA + 2 * kA * k / segments) * dir);
-  crack.start_is_tip = true;
-  crack.end_is_tip = true;
-  c.cracks = {crack};
-  c.damping.grid_alpha = critical_alpha(2 * b);
   c.threads = 1;
+  c.fracture.inner_cells = 3;
+  c.fracture.outer_cells = 7;
+  c.fracture.propagate = true;
+  c.fracture.growth_cells = 0.25;
+  c.fracture.settle_transits = 2;
+  c.materials[0].toughness = k_ic * k_ic / kRock.plane_strain_modulus();
   return c;
 }
+
+// s, one P-wave transit of the plate [-b, b]^2.
+double transit_time(double b) { return 2 * b / kRock.p_wave_speed(kRock.density); }
 
 // One growth decision: the tip as evaluated by the check that grew it.
 struct Growth {
@@ -53,16 +48,15 @@ struct Growth {
   std::vector<Vec2> plane;             // the crack after the step
 };
 
-double j_over_k(const TipResult& tip) {
-  return tip.j * tip.modulus / (tip.k1 * tip.k1 + tip.k2 * tip.k2);
-}
+double j_over_k(const TipResult& tip) { return tip.j * tip.modulus / (tip.k1 * tip.k1 + tip.k2 * tip.k2); }
 
 void print(const Growth& g) {
   const auto& t = g.tip;
-  std::printf("  %s tip step %d at (%+.4f, %+.4f): J %.4e J/m^2, J/((K_I^2+K_II^2)/E') %.4f, K_I %.4e, "
-              "K_II/K_I %+.4f, kink %+.2f deg\n",
-              t.at_end ? "end  " : "start", t.at_end ? g.end_grown : g.start_grown, t.position.x(), t.position.y(),
-              t.j, j_over_k(t), t.k1, t.k2 / t.k1, t.kink * 180 / kPi);
+  std::printf(
+      "  %s tip step %d at (%+.4f, %+.4f): J %.4e J/m^2, J/((K_I^2+K_II^2)/E') %.4f, K_I %.4e, "
+      "K_II/K_I %+.4f, kink %+.2f deg\n",
+      t.at_end ? "end  " : "start", t.at_end ? g.end_grown : g.start_grown, t.position.x(), t.position.y(), t.j,
+      j_over_k(t), t.k1, t.k2 / t.k1, t.kink * 180 / kPi);
 }
 
 // Steps `solid` with the face pressure pressure(t) until `done` says so or
@@ -95,7 +89,8 @@ std::vector<Growth> grow(Solver& solid, Pressure pressure, Done done, double end
 // `origin` along `dir`, and the heading (rad) of the chord from `from` to `to`.
 double off_line(const std::vector<Vec2>& points, const Vec2& origin, const Vec2& dir) {
   double worst = 0;
-  for (const auto& p : points) worst = std::max(worst, std::abs((p - origin).x() * dir.y() - (p - origin).y() * dir.x()));
+  for (const auto& p : points)
+    worst = std::max(worst, std::abs((p - origin).x() * dir.y() - (p - origin).y() * dir.x()));
   return worst;
 }
 
@@ -132,26 +127,23 @@ TEST(ObliqueGrowth, IsotropicStressGrowsStraightAndSymmetric) {
   const double h = kA / cells, b = 5 * kA, s0 = -4e6, k_ic = 3.9e6;
   const double angle = kPi / 4;
   const Vec2 centre(h / 2, 0);
-  SolidConfig c = oblique_crack(h, b, angle, centre, s0, s0);
-  c.fracture.inner_cells = 3;
-  c.fracture.outer_cells = 7;
-  c.fracture.propagate = true;
-  c.fracture.growth_cells = 0.25;
-  c.fracture.settle_transits = 2;
-  c.materials[0].toughness = k_ic * k_ic / kRock.plane_strain_modulus();
+  SolidConfig c = oblique_crack(h, b, angle, centre, s0, s0, k_ic);
   Solver solid(c);
-  const double transit = 2 * b / kRock.p_wave_speed(kRock.density);
+  const double transit = transit_time(b);
   const double p_end = -s0 + 1.3 * k_ic / std::sqrt(kPi * kA);
   auto pressure = [&](double t) { return p_end * std::min(1.0, t / (20 * transit)); };
   constexpr int kSteps = 10;
   // One step more: the checks that grow the tips the 11th time see the
   // settled field of the crack grown 10 times (the re-solve's reference).
-  const auto log = grow(solid, pressure, [](int s, int e) { return s > kSteps && e > kSteps; }, 60 * transit);
+  const auto log = grow(
+      solid, pressure, [](int s, int e) { return s > kSteps && e > kSteps; }, 60 * transit);
   ASSERT_FALSE(log.empty()) << "the crack never grew";
   for (const auto& tip : solid.last_tips()) {
-    std::printf("at the end (t = %.1f transits): %s tip J %.4e J/m^2, K_I %.4e (%.2f K_Ic), K_II/K_I %+.4f, "
-                "kinetic energy %.3e J/m\n", solid.time() / transit, tip.at_end ? "end" : "start", tip.j, tip.k1,
-                tip.k1 / k_ic, tip.k2 / tip.k1, solid.kinetic_energy());
+    std::printf(
+        "at the end (t = %.1f transits): %s tip J %.4e J/m^2, K_I %.4e (%.2f K_Ic), K_II/K_I %+.4f, "
+        "kinetic energy %.3e J/m\n",
+        solid.time() / transit, tip.at_end ? "end" : "start", tip.j, tip.k1, tip.k1 / k_ic, tip.k2 / tip.k1,
+        solid.kinetic_energy());
   }
   ASSERT_GT(log.back().start_grown, kSteps);
   ASSERT_GT(log.back().end_grown, kSteps);
@@ -162,9 +154,8 @@ TEST(ObliqueGrowth, IsotropicStressGrowsStraightAndSymmetric) {
   }
   // The crack after both tips grew kSteps times, and J at the checks that
   // grew them once more (that crack's settled field).
-  const auto tenth = std::find_if(log.begin(), log.end(), [](const Growth& g) {
-    return g.start_grown == kSteps && g.end_grown == kSteps;
-  });
+  const auto tenth = std::find_if(log.begin(), log.end(),
+                                  [](const Growth& g) { return g.start_grown == kSteps && g.end_grown == kSteps; });
   ASSERT_NE(tenth, log.end());
   const auto& plane = tenth->plane;
   const Vec2 dir(std::cos(angle), std::sin(angle));
@@ -174,10 +165,11 @@ TEST(ObliqueGrowth, IsotropicStressGrowsStraightAndSymmetric) {
   const std::vector<Vec2> end_part(plane.begin() + static_cast<std::ptrdiff_t>(start_new + initial), plane.end());
   const double grown = kSteps * c.fracture.growth_cells * h;
   const double start_off = off_line(start_part, centre, dir), end_off = off_line(end_part, centre, dir);
-  std::printf("grown by %zu (start) and %zu (end) particles; largest distance from the crack line %.3e m (start), "
-              "%.3e m (end), %.2f and %.2f deg over the grown length\n",
-              start_part.size(), end_part.size(), start_off, end_off, std::atan(start_off / grown) * 180 / kPi,
-              std::atan(end_off / grown) * 180 / kPi);
+  std::printf(
+      "grown by %zu (start) and %zu (end) particles; largest distance from the crack line %.3e m (start), "
+      "%.3e m (end), %.2f and %.2f deg over the grown length\n",
+      start_part.size(), end_part.size(), start_off, end_off, std::atan(start_off / grown) * 180 / kPi,
+      std::atan(end_off / grown) * 180 / kPi);
   EXPECT_LT(start_off, std::tan(2 * kPi / 180) * grown);
   EXPECT_LT(end_off, std::tan(2 * kPi / 180) * grown);
 
@@ -198,9 +190,11 @@ TEST(ObliqueGrowth, IsotropicStressGrowsStraightAndSymmetric) {
       return g.tip.at_end == tip.at_end && (tip.at_end ? g.end_grown : g.start_grown) == kSteps + 1;
     });
     ASSERT_NE(settled, log.end());
-    std::printf("re-solve from rest, %s tip: J %.4e J/m^2 (growth run %.4e, ratio %.4f), K_I %.4e (growth run %.4e), "
-                "K_II/K_I %+.4f\n", tip.at_end ? "end" : "start", tip.j, settled->tip.j, settled->tip.j / tip.j,
-                tip.k1, settled->tip.k1, tip.k2 / tip.k1);
+    std::printf(
+        "re-solve from rest, %s tip: J %.4e J/m^2 (growth run %.4e, ratio %.4f), K_I %.4e (growth run %.4e), "
+        "K_II/K_I %+.4f\n",
+        tip.at_end ? "end" : "start", tip.j, settled->tip.j, settled->tip.j / tip.j, tip.k1, settled->tip.k1,
+        tip.k2 / tip.k1);
     EXPECT_NEAR(settled->tip.j / tip.j, 1, 0.05);
   }
 }
@@ -222,7 +216,8 @@ double x_at_height(const std::vector<Vec2>& plane, bool from_end, double y) {
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const Vec2& a = plane[from_end ? n - 1 - i : i];
     const Vec2& b = plane[from_end ? n - 2 - i : i + 1];
-    if ((a.y() - y) * (b.y() - y) <= 0 && a.y() != b.y()) return a.x() + (y - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
+    if ((a.y() - y) * (b.y() - y) <= 0 && a.y() != b.y())
+      return a.x() + (y - a.y()) / (b.y() - a.y()) * (b.x() - a.x());
   }
   return std::nan("");
 }
@@ -230,37 +225,33 @@ double x_at_height(const std::vector<Vec2>& plane, bool from_end, double y) {
 struct Turned {
   std::vector<Vec2> plane;
   std::size_t start_initial = 0, end_initial = 0;  // indices of the initial tips in plane
-  double start_heading = 0, end_heading = 0;        // deg
+  double start_heading = 0, end_heading = 0;       // deg
 };
 
 // The 45-degree crack in sigma_xx = -2 MPa, sigma_yy = -6 MPa, pressurised
 // until both tips have grown `length` m (quarter-cell steps, settled).
 Turned turn_in_anisotropic_stress(double h, double length) {
   const double b = 5 * kA, k_ic = 3.9e6;
-  SolidConfig c = oblique_crack(h, b, kPi / 4, Vec2(h / 2, 0), -2e6, -6e6);
-  c.fracture.inner_cells = 3;
-  c.fracture.outer_cells = 7;
-  c.fracture.propagate = true;
-  c.fracture.growth_cells = 0.25;
-  c.fracture.settle_transits = 2;
-  c.materials[0].toughness = k_ic * k_ic / kRock.plane_strain_modulus();
+  SolidConfig c = oblique_crack(h, b, kPi / 4, Vec2(h / 2, 0), -2e6, -6e6, k_ic);
   Solver solid(c);
-  const double transit = 2 * b / kRock.p_wave_speed(kRock.density);
+  const double transit = transit_time(b);
   const double p_end = 4e6 + 1.3 * k_ic / std::sqrt(kPi * kA);
   auto pressure = [&](double t) { return p_end * std::min(1.0, t / (20 * transit)); };
   const int steps = static_cast<int>(std::ceil(length / (c.fracture.growth_cells * h)));
-  const auto log = grow(solid, pressure, [&](int s, int e) { return s >= steps && e >= steps; }, 80 * transit);
+  const auto log = grow(
+      solid, pressure, [&](int s, int e) { return s >= steps && e >= steps; }, 80 * transit);
   Turned out;
   out.plane = solid.cracks()[0].plane();
   out.start_initial = static_cast<std::size_t>(log.empty() ? 0 : log.back().start_grown);
   out.end_initial = out.start_initial + static_cast<std::size_t>(std::lround(4 * kA / h));
   out.start_heading = heading(out.plane, false, 2 * h);
   out.end_heading = heading(out.plane, true, 2 * h);
-  std::printf("h = a/%.0f: start tip grew %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = -1.5 m at "
-              "x = %+.4f m; end tip %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = 1.5 m at x = %+.4f m\n",
-              kA / h, out.start_initial, out.plane.front().x(), out.plane.front().y(), out.start_heading,
-              x_at_height(out.plane, false, -1.5), out.plane.size() - 1 - out.end_initial, out.plane.back().x(),
-              out.plane.back().y(), out.end_heading, x_at_height(out.plane, true, 1.5));
+  std::printf(
+      "h = a/%.0f: start tip grew %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = -1.5 m at "
+      "x = %+.4f m; end tip %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = 1.5 m at x = %+.4f m\n",
+      kA / h, out.start_initial, out.plane.front().x(), out.plane.front().y(), out.start_heading,
+      x_at_height(out.plane, false, -1.5), out.plane.size() - 1 - out.end_initial, out.plane.back().x(),
+      out.plane.back().y(), out.end_heading, x_at_height(out.plane, true, 1.5));
   return out;
 }
 
@@ -307,21 +298,15 @@ TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {
 // the new branch turns.
 TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
   const double h = kA / 5, b = 5 * kA, k_ic = 1e6;
-  SolidConfig c = oblique_crack(h, b, kPi / 4, Vec2(h / 2, 0), 0, 0);
+  SolidConfig c = oblique_crack(h, b, kPi / 4, Vec2(h / 2, 0), 0, 0, k_ic);
   const double sigma_c = k_ic / (std::sqrt(kPi * kA) / std::sqrt(2.0));  // |K| = sigma sqrt(pi a) / sqrt(2)
-  const double transit = 2 * b / kRock.p_wave_speed(kRock.density);
+  const double transit = transit_time(b);
   const auto sigma = TimeFunction::table({0, 20 * transit}, {0, 1.3 * sigma_c});
   c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
-  c.fracture.inner_cells = 3;
-  c.fracture.outer_cells = 7;
-  c.fracture.propagate = true;
-  c.fracture.growth_cells = 0.25;
-  c.fracture.settle_transits = 2;
-  c.materials[0].toughness = k_ic * k_ic / kRock.plane_strain_modulus();
   Solver solid(c);
   const int kSteps = std::getenv("HFMPM_TENSION_STEPS") ? std::atoi(std::getenv("HFMPM_TENSION_STEPS")) : 12;
-  const auto log = grow(solid, [](double) { return 0.0; }, [&](int s, int e) { return s >= kSteps && e >= kSteps; },
-                        80 * transit);
+  const auto log = grow(
+      solid, [](double) { return 0.0; }, [&](int s, int e) { return s >= kSteps && e >= kSteps; }, 80 * transit);
   ASSERT_FALSE(log.empty()) << "the crack never grew";
   EXPECT_GE(log.back().start_grown, kSteps);
   EXPECT_GE(log.back().end_grown, kSteps);
@@ -340,7 +325,8 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
   for (const bool at_end : {false, true}) {
     std::vector<double> headings;
     if (at_end) {
-      for (std::size_t k = start_new + initial - 1; k + 1 < plane.size(); ++k) headings.push_back(segment_heading(k, k + 1, false));
+      for (std::size_t k = start_new + initial - 1; k + 1 < plane.size(); ++k)
+        headings.push_back(segment_heading(k, k + 1, false));
     } else {
       for (std::size_t k = start_new; k > 0; --k) headings.push_back(segment_heading(k, k - 1, true));
     }
