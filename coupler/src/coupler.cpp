@@ -76,7 +76,7 @@ RunSummary Coupler::run() {
   summary.fluid_compute_s = sides_[1].compute_s;
   summary.solid_exchange_s = sides_[0].exchange_s;
   summary.fluid_exchange_s = sides_[1].exchange_s;
-  summary.sides_in_sequence = scene_.coupling().scheme() == scene::Coupling::GAUSS_SEIDEL;
+  summary.sides_in_sequence = scene_.coupling().scheme() != scene::Coupling::JACOBI;
   manifest_.set_number("steps", static_cast<double>(step_));
   manifest_.set_number("end_time_s", t_);
   manifest_.set_number("wall_s", summary.wall_s);

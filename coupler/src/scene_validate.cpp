@@ -77,7 +77,11 @@ void check_coupling(Checker& c, const scene::Coupling& k) {
     c.bad("coupling.transport", "TRANSPORT_UNSPECIFIED", "IPC, TCP or INPROC");
   }
   if (k.scheme() == scene::Coupling::SCHEME_UNSPECIFIED) {
-    c.bad("coupling.scheme", "SCHEME_UNSPECIFIED", "JACOBI or GAUSS_SEIDEL");
+    c.bad("coupling.scheme", "SCHEME_UNSPECIFIED", "JACOBI, GAUSS_SEIDEL or IMPLICIT");
+  }
+  if (k.scheme() == scene::Coupling::IMPLICIT && k.exchange_interval() != 1) {
+    c.bad("coupling.exchange_interval", std::to_string(k.exchange_interval()),
+          "1 with coupling.scheme = IMPLICIT (the fluid needs the solid's response over every step)");
   }
   if (k.exchange_interval() < 1 || k.exchange_interval() > 10000) {
     c.bad("coupling.exchange_interval", std::to_string(k.exchange_interval()), "an integer from 1 to 10000 (steps)");

@@ -152,7 +152,13 @@ class SideRuntime {
     heartbeat_timeout_ = to_us(scene.coupling().heartbeat_timeout_s());
     spin_ = microseconds(scene.coupling().spin_us());
     exchange_interval_ = std::max(1u, scene.coupling().exchange_interval());
-    gauss_seidel_ = scene.coupling().scheme() == scene::Coupling::GAUSS_SEIDEL;
+    // Sequential schemes: one side waits for the other's frame of the same
+    // step before it steps. Gauss-Seidel: the fluid waits for the solid's new
+    // crack. Implicit: the solid waits for the pressure the fluid solved
+    // over the step it is about to finish.
+    const auto scheme = scene.coupling().scheme();
+    waits_first_ = (scheme == scene::Coupling::GAUSS_SEIDEL && options_.role == protocol::FLUID) ||
+                   (scheme == scene::Coupling::IMPLICIT && options_.role == protocol::SOLID);
 
     const std::string& chosen = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
     const std::string output_dir = chosen.empty() ? std::string(".") : chosen;
@@ -256,9 +262,8 @@ class SideRuntime {
     check_command(command);
     t_ = command.t();
     double compute_s = 0, exchange_s = 0;
-    const bool fluid_waits_first = gauss_seidel_ && options_.role == protocol::FLUID;
     for (std::uint32_t i = 0; i < command.num_steps(); ++i) {
-      if (has_peer_ && fluid_waits_first && step_ % exchange_interval_ == 0) {
+      if (has_peer_ && waits_first_ && step_ % exchange_interval_ == 0) {
         const auto start = Clock::now();
         consume(step_ + exchange_interval_);
         exchange_s += seconds_since(start);
@@ -273,7 +278,7 @@ class SideRuntime {
       if (has_peer_ && step_ % exchange_interval_ == 0) {
         const auto exchange_start = Clock::now();
         publish();
-        if (!fluid_waits_first) consume(step_);
+        if (!waits_first_) consume(step_);
         exchange_s += seconds_since(exchange_start);
       }
     }
@@ -439,7 +444,7 @@ class SideRuntime {
   microseconds heartbeat_timeout_{3'000'000};
   microseconds spin_{0};
   std::uint32_t exchange_interval_ = 1;
-  bool gauss_seidel_ = false;
+  bool waits_first_ = false;  // this side consumes the peer's frame of a step before stepping
   bool has_peer_ = false;
   bool poison_next_frame_ = false;
   bool set_up_ = false;

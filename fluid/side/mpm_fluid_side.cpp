@@ -18,6 +18,7 @@ class MpmFluidSide final : public coupling::SideModel {
     if (!scene.fluid().has_mpm()) throw coupling::InputError("this side runs fluid.mpm scenes only");
     const auto& f = scene.fluid().mpm();
     config_ = to_fluid_config(f);
+    config_.implicit_interface = scene.coupling().scheme() == scene::Coupling::IMPLICIT;
     try {
       mpm::FluidSolver check(config_);  // the library's own range checks, before any crack arrives
     } catch (const std::invalid_argument& e) {
@@ -99,7 +100,7 @@ class MpmFluidSide final : public coupling::SideModel {
       d.fluid_volume += s.fluid_volume();
       d.front_position = std::max(d.front_position, s.front_position());
       d.fluid_particles += static_cast<std::uint32_t>(s.particles().size());
-      d.coupling_lag = std::max(d.coupling_lag, s.frozen_width_rise());
+      d.coupling_lag = std::max(d.coupling_lag, config_.implicit_interface ? s.interface_mismatch() : s.frozen_width_rise());
     }
     return d;
   }

@@ -67,6 +67,10 @@ void to_proto(const CrackGeometry& crack, protocol::CrackState::Crack* out) {
   out->mutable_width()->Add(crack.width.begin(), crack.width.end());
   out->mutable_tip()->Reserve(n);
   for (char t : crack.tip) out->add_tip(t != 0);
+  out->mutable_opening_rate()->Add(crack.opening_rate.begin(), crack.opening_rate.end());
+  out->mutable_opening_acceleration()->Add(crack.opening_acceleration.begin(), crack.opening_acceleration.end());
+  out->mutable_opening_compliance()->Add(crack.opening_compliance.begin(), crack.opening_compliance.end());
+  out->set_opening_compliance_band(crack.compliance_band);
 }
 
 CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
@@ -86,12 +90,38 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
   check_finite(type, id, "ny", crack.ny());
   check_finite(type, id, "width", crack.width());
   check_unique_ids(type, id, crack.ids());
+  const bool response = crack.opening_rate_size() > 0 || crack.opening_acceleration_size() > 0 ||
+                        crack.opening_compliance_size() > 0;
+  if (response) {
+    check_length(type, id, "opening_rate", crack.opening_rate(), n);
+    check_length(type, id, "opening_acceleration", crack.opening_acceleration(), n);
+    const std::uint32_t band = crack.opening_compliance_band();
+    if (band >= static_cast<std::uint32_t>(n)) {
+      fail(type, id,
+           "opening_compliance_band = " + std::to_string(band) + "; it must be less than the " + std::to_string(n) +
+               " ids");
+    }
+    const auto expected = static_cast<std::int64_t>(n) * (2 * static_cast<std::int64_t>(band) + 1);
+    if (crack.opening_compliance_size() != expected) {
+      fail(type, id,
+           "array 'opening_compliance' has " + std::to_string(crack.opening_compliance_size()) + " entries; with " +
+               std::to_string(n) + " ids and opening_compliance_band " + std::to_string(band) + " it needs " +
+               std::to_string(expected) + " (ids x (2 band + 1))");
+    }
+    check_finite(type, id, "opening_rate", crack.opening_rate());
+    check_finite(type, id, "opening_acceleration", crack.opening_acceleration());
+    check_finite(type, id, "opening_compliance", crack.opening_compliance());
+  }
 
   CrackGeometry out;
   out.crack_id = id;
   out.grew = crack.grew();
   out.ids.assign(crack.ids().begin(), crack.ids().end());
   out.width.assign(crack.width().begin(), crack.width().end());
+  out.opening_rate.assign(crack.opening_rate().begin(), crack.opening_rate().end());
+  out.opening_acceleration.assign(crack.opening_acceleration().begin(), crack.opening_acceleration().end());
+  out.opening_compliance.assign(crack.opening_compliance().begin(), crack.opening_compliance().end());
+  out.compliance_band = response ? crack.opening_compliance_band() : 0;
   out.position.resize(static_cast<std::size_t>(n));
   out.normal.resize(static_cast<std::size_t>(n));
   out.tip.resize(static_cast<std::size_t>(n));

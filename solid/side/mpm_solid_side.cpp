@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <cstdio>
+#include <cstdlib>
 #include <optional>
 
 #include "hfmpm/output/frame_writer.hpp"
@@ -37,6 +39,7 @@ class MpmSolidSide final : public coupling::SideModel {
     } catch (const std::invalid_argument& e) {
       throw coupling::InputError(std::string("solid.mpm: ") + e.what());
     }
+    implicit_ = scene.has_fluid() && scene.coupling().scheme() == scene::Coupling::IMPLICIT;
     // Without a fluid, a crack may carry a prescribed face pressure.
     for (const auto& crack : scene.solid().mpm().cracks()) {
       prescribed_.push_back(!scene.has_fluid() && crack.has_pressure_pa()
@@ -55,7 +58,26 @@ class MpmSolidSide final : public coupling::SideModel {
       const double p = (*prescribed_[c])(solver_->time());
       solver_->set_crack_pressure(c, std::vector<double>(solver_->cracks()[c].size(), p));
     }
+    std::vector<double> predicted;
+    const bool debug = implicit_ && std::getenv("HFMPM_DEBUG_RESPONSE") && solver_->step_begun() && !solver_->cracks().empty();
+    if (debug) {
+      const auto& crack = solver_->cracks()[0];
+      const auto r = solver_->face_response(0);
+      const std::size_t n = crack.size(), row = 2 * r.band + 1;
+      for (std::size_t k = 0; k < n; ++k) {
+        double load = 0;
+        for (std::size_t j = k >= r.band ? k - r.band : 0; j <= std::min(n - 1, k + r.band); ++j)
+          load += r.compliance[k * row + j + r.band - k] * crack.face_pressure(j);
+        predicted.push_back(crack.width(k) + dt * (r.rate[k] + dt * (r.acceleration[k] + load)));
+      }
+    }
     solver_->step(dt);
+    if (debug && solver_->steps() < 5) {
+      const auto& crack = solver_->cracks()[0];
+      std::fprintf(stderr, "solid step %lu contacts %lu\n", (unsigned long)solver_->steps(), (unsigned long)solver_->contacts());
+      for (std::size_t k = 0; k < predicted.size() && k < crack.size(); ++k)
+        std::fprintf(stderr, "  %zu predicted %.4e actual %.4e p %.1f\n", k, predicted[k], crack.width(k), crack.face_pressure(k));
+    }
   }
   void publish(protocol::DataFrame& frame) override {
     auto* state = frame.mutable_crack();
@@ -63,6 +85,14 @@ class MpmSolidSide final : public coupling::SideModel {
     for (std::size_t c = 0; c < solver_->cracks().size(); ++c) {
       const auto& crack = solver_->cracks()[c];
       auto g = geometry(crack);
+      if (implicit_) {  // the faces' response over the coming step, for the fluid's interface solve
+        solver_->begin_step();
+        auto r = solver_->face_response(c);
+        g.opening_rate = std::move(r.rate);
+        g.opening_acceleration = std::move(r.acceleration);
+        g.opening_compliance = std::move(r.compliance);
+        g.compliance_band = static_cast<std::uint32_t>(r.band);
+      }
       g.grew = published_[c] != 0 && crack.size() > published_[c];
       published_[c] = crack.size();
       proto::to_proto(g, state->add_cracks());
@@ -170,6 +200,7 @@ class MpmSolidSide final : public coupling::SideModel {
 
   std::optional<mpm::Solver> solver_;
   std::vector<std::optional<TimeFunction>> prescribed_;
+  bool implicit_ = false;                // coupling.scheme IMPLICIT: publish the faces' response
   std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)
   std::optional<output::FrameWriter> writer_;
 };

@@ -35,7 +35,11 @@ double FluidSolver::mouth_pressure() const {
   return particles_.size() > 0 ? particles_.pressure[0] : 0.0;
 }
 
-double FluidSolver::inlet_pressure() const { return mouth_pressure(); }
+double FluidSolver::inlet_pressure() const {
+  // The implicit step reports the mouth pressure it solved over the step.
+  if (config_.implicit_interface && !nodal_pressure_.empty()) return nodal_pressure_[0];
+  return mouth_pressure();
+}
 
 bool FluidSolver::seed(double dt) {
   const auto& inlet = config_.inlet;

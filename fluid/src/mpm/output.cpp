@@ -44,39 +44,46 @@ void FluidSolver::fill(double front, double pressure) {
 }
 
 void FluidSolver::project_pressure() {
+  project_pressure(particles_.pressure, nodal_pressure_, mass_);
+}
+
+void FluidSolver::project_pressure(const std::vector<double>& pp, std::vector<double>& nodal,
+                                   std::vector<double>& scratch) const {
   // Mass-weighted CPDI projection p_i = sum Nbar_ip m_p p_p / sum Nbar_ip m_p;
   // masses never vanish, so every wetted node has a value.
   const std::size_t n = grid_.size();
-  nodal_pressure_.assign(n, 0.0);
+  nodal.assign(n, 0.0);
   if (particles_.size() == 0) return;  // the shapes are current: update_state() built them
-  std::fill(mass_.begin(), mass_.end(), 0.0);
+  scratch.assign(n, 0.0);
   for (std::size_t p = 0; p < particles_.size(); ++p) {
     const CpdiRange r = shapes_.range[p];
     const double* N = shapes_.weight.data() + shapes_.offset[p];
-    const double m = particles_.mass[p], mp = m * particles_.pressure[p];
+    const double m = particles_.mass[p], mp = m * pp[p];
     for (std::size_t k = 0; k < r.count; ++k) {
-      mass_[r.first + k] += N[k] * m;
-      nodal_pressure_[r.first + k] += N[k] * mp;
+      scratch[r.first + k] += N[k] * m;
+      nodal[r.first + k] += N[k] * mp;
     }
   }
   const double front = front_position() + 1e-12 * grid_.length();
   for (std::size_t i = 0; i < n; ++i) {
-    const bool wetted = grid_.arc()[i] <= front && mass_[i] > 0;
-    nodal_pressure_[i] = wetted ? std::max(0.0, nodal_pressure_[i] / mass_[i]) : 0.0;  // lag zone beyond the front
+    const bool wetted = grid_.arc()[i] <= front && scratch[i] > 0;
+    nodal[i] = wetted ? std::max(0.0, nodal[i] / scratch[i]) : 0.0;  // lag zone beyond the front
   }
   if (config_.lag == FluidConfig::Lag::Fixed) {
     for (std::size_t i = 0; i < n; ++i)
-      if (grid_.arc()[i] > front) nodal_pressure_[i] = config_.lag_pressure;
+      if (grid_.arc()[i] > front) nodal[i] = config_.lag_pressure;
   }
+  const double mouth =
+      config_.inlet.kind == InletConfig::Kind::Pressure ? std::max(0.0, config_.inlet.pressure(t_)) : pp[0];
   if (config_.lag == FluidConfig::Lag::Front) {
-    const double p_front = std::min(particles_.pressure[particles_.size() - 1], mouth_pressure());
+    const double p_front = std::min(pp[particles_.size() - 1], mouth);
     // Only up to the first node beyond the front: the crack the fluid is
     // about to enter. Further on, the crack is dry (p = 0): a lag zone
     // loaded all the way to the tip let a crack with little toughness run
     // dry (0.25 -> 1.02 m in 0.25 s in the viscosity-dominated KGD).
     for (std::size_t i = 0; i < n; ++i) {
       if (grid_.arc()[i] > front) {
-        nodal_pressure_[i] = p_front;
+        nodal[i] = p_front;
         break;
       }
     }
@@ -84,8 +91,8 @@ void FluidSolver::project_pressure() {
   // Where the pressure is held (the mouth, a wetted outlet) the node carries
   // that boundary value, not the one-sided projection (which is the pressure
   // about half an element inside).
-  nodal_pressure_[0] = mouth_pressure();
-  if (outlet_wetted_) nodal_pressure_[n - 1] = std::max(0.0, config_.outlet.pressure(t_));
+  nodal[0] = mouth;
+  if (outlet_wetted_) nodal[n - 1] = std::max(0.0, config_.outlet.pressure(t_));
 }
 
 std::vector<double> FluidSolver::nodal_stiffness() const {
@@ -157,8 +164,10 @@ CrackPressure FluidSolver::pressure_message() const {
   m.crack_id = grid_.crack_id();
   m.ids = grid_.ids();
   m.pressure = nodal_pressure_;
-  m.stiffness = nodal_stiffness();
-  m.width = grid_.crack_width();
+  if (!config_.implicit_interface) {  // the implicit step's pressure already follows the faces
+    m.stiffness = nodal_stiffness();
+    m.width = grid_.crack_width();
+  }
   m.front_position = front_position();
   m.inlet_flux = inlet_flux_;
   m.fluid_volume = fluid_volume();

@@ -21,6 +21,15 @@ struct CrackGeometry {
   std::vector<double> width;       // m, opening, >= 0
   std::vector<char> tip;           // 1 at a tip
   bool grew = false;               // ids appended since the previous publication
+  // Optional (empty, or one per id; coupling.scheme IMPLICIT): the faces'
+  // response over the coming step of dt under face pressures p_j:
+  //   w_k(t + dt) = width_k + dt (opening_rate_k + dt (opening_acceleration_k + sum_j C_kj p_j)),
+  // C banded, |k - j| <= compliance_band, row-major:
+  // C_kj = opening_compliance[k (2 band + 1) + j - k + band].
+  std::vector<double> opening_rate;          // m/s
+  std::vector<double> opening_acceleration;  // m/s^2, all loads but the face pressure
+  std::vector<double> opening_compliance;    // m/s^2 per Pa, size() (2 band + 1)
+  std::uint32_t compliance_band = 0;
 
   std::size_t size() const { return ids.size(); }
 };

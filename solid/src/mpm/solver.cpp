@@ -211,19 +211,30 @@ double Solver::strain_energy() const {
   return e;
 }
 
-void Solver::step(double dt) {
+void Solver::begin_step() {
+  if (step_begun_) return;
   ++epoch_;
   if (cracks_.empty()) {
     p2g<false>();
     edge_loads();
-    grid_update(dt);
-    g2p<false>(dt);
   } else {
     for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h, 1e-6 * config_.grid.h);
     p2g<true>();
     contact(0.0);  // on the extrapolated momenta
     edge_loads();
-    crack_loads();
+    crack_loads(true, false);
+  }
+  step_begun_ = true;
+}
+
+void Solver::step(double dt) {
+  begin_step();
+  step_begun_ = false;
+  if (cracks_.empty()) {
+    grid_update(dt);
+    g2p<false>(dt);
+  } else {
+    crack_loads(false, true);
     grid_update(dt);
     if (config_.implicit_face_stiffness) implicit_face_stiffness(dt);
     contact(dt);  // on the updated momenta, forces made consistent

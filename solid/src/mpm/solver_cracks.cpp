@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <unordered_map>
+#include <utility>
 
 #include "hfmpm/solid/mpm/predicates.hpp"
 #include "hfmpm/solid/mpm/shape.hpp"
@@ -136,21 +139,106 @@ void Solver::spread_face_force(const Crack& crack, std::size_t k, int side, cons
   }
 }
 
-void Solver::crack_loads() {
+void Solver::crack_loads(bool in_situ, bool pressure) {
+  const bool with_in_situ = in_situ && config_.in_situ_reference;
   for (const auto& crack : cracks_) {
     for (std::size_t k = 0; k < crack.size(); ++k) {
-      const double p = crack.face_pressure(k);
       const Vec2 n = crack.normal(k);
       // Pressure opens the crack: +n into the field above, -n into the field
       // below. With the in-situ stress as reference the faces also give up
       // the in-situ traction sigma0 n that the uncut body carried across them.
-      Vec2 t = p * n;
-      if (config_.in_situ_reference) t += traction(in_situ_stress(crack.plane()[k]), n);
+      Vec2 t = Vec2::Zero();
+      if (pressure) t += crack.face_pressure(k) * n;
+      if (with_in_situ) t += traction(in_situ_stress(crack.plane()[k]), n);
       if (t.squaredNorm() == 0) continue;
       const Vec2 force = crack.tributary_length(k) * t;
       for (int side : {1, -1}) spread_face_force(crack, k, side, side * force);
     }
   }
+}
+
+Solver::FaceResponse Solver::face_response(std::size_t c) const {
+  if (!step_begun_) throw std::logic_error("Solver::face_response needs begin_step() first");
+  const Crack& crack = cracks_.at(c);
+  const std::size_t count = crack.size();
+  const NodalFields* fields[2] = {&nodes_, &second_};
+  const double alpha = config_.damping.grid_alpha + feedback_alpha_;
+  auto key = [](int node, int field) { return static_cast<std::size_t>(node) * 2 + static_cast<std::size_t>(field); };
+  auto tip = [&](std::size_t k) { return (k == 0 && crack.start_is_tip()) || (k + 1 == count && crack.end_is_tip()); };
+  // Per node field: the acceleration a unit face pressure at crack particle
+  // j gives it (as crack_loads spreads the load), for every j that loads it.
+  std::unordered_map<std::size_t, std::vector<std::pair<std::size_t, Vec2>>> loaded;
+  for (std::size_t j = 0; j < count; ++j) {
+    const Vec2 force = crack.tributary_length(j) * crack.normal(j);
+    for (int side : {1, -1}) {
+      const FaceShares s = face_shares(crack, j, side);
+      for (int i = 0; i < s.count; ++i) {
+        const auto u = static_cast<std::size_t>(s.node[i]);
+        const NodalFields& nd = *fields[s.field[i]];
+        Vec2 a = side * s.share[i] * force / nd.mass[u];
+        if (nd.fixed[u] & 1) a.x() = 0;
+        if (nd.fixed[u] & 2) a.y() = 0;
+        loaded[key(s.node[i], s.field[i])].push_back({j, a});
+      }
+    }
+  }
+  FaceResponse out;
+  out.rate.assign(count, 0.0);
+  out.acceleration.assign(count, 0.0);
+  // Each surface moves with the mass-weighted velocity of its side's nodes
+  // (move_crack_surfaces); collect its weights first, then the band.
+  struct Read {
+    std::size_t key;
+    double weight;  // signed: + above, - below
+  };
+  std::vector<std::vector<Read>> reads(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    if (tip(k)) continue;  // both surfaces of a tip move together: no opening
+    const Vec2 n = crack.normal(k);
+    for (int s = 0; s < 2; ++s) {
+      const int side = s == 0 ? 1 : -1;
+      double mass = 0;
+      Vec2 v_sum = Vec2::Zero(), a_sum = Vec2::Zero();
+      std::vector<Read> mine;
+      for_side_nodes(*this, config_.grid, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
+        const auto u = static_cast<std::size_t>(nd);
+        const NodalFields& field = *fields[f];
+        const double m = field.mass[u];
+        Vec2 v = field.momentum[u] / m, a = (field.force[u] - alpha * field.momentum[u]) / m;
+        if (field.fixed[u] & 1) v.x() = a.x() = 0;
+        if (field.fixed[u] & 2) v.y() = a.y() = 0;
+        mass += w * m;
+        v_sum += w * m * v;
+        a_sum += w * m * a;
+        mine.push_back({key(nd, f), w * m});
+      });
+      if (!(mass > 0)) continue;
+      out.rate[k] += side * v_sum.dot(n) / mass;
+      out.acceleration[k] += side * a_sum.dot(n) / mass;
+      for (auto& r : mine) reads[k].push_back({r.key, side * r.weight / mass});
+    }
+  }
+  // The band: C_kj = d(opening acceleration at k) / d(pressure at j).
+  std::size_t band = 0;
+  std::vector<std::vector<std::pair<std::size_t, double>>> rows(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const Vec2 n = crack.normal(k);
+    for (const auto& r : reads[k]) {
+      const auto it = loaded.find(r.key);
+      if (it == loaded.end()) continue;
+      for (const auto& [j, a] : it->second) {
+        rows[k].push_back({j, r.weight * a.dot(n)});
+        band = std::max(band, j > k ? j - k : k - j);
+      }
+    }
+  }
+  out.band = band;
+  const std::size_t width = 2 * band + 1;
+  out.compliance.assign(count * width, 0.0);
+  for (std::size_t k = 0; k < count; ++k) {
+    for (const auto& [j, value] : rows[k]) out.compliance[k * width + (j + band - k)] += value;
+  }
+  return out;
 }
 
 // Implicit face stiffness. The face pressure p - s (w - w_ref) is a spring

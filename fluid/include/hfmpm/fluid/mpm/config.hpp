@@ -56,6 +56,12 @@ struct FluidConfig {
   // (against volumetric locking, see FluidSolver::element_pressure); false:
   // each particle's pressure from its own J = F11 F22.
   bool smooth_jacobian = true;
+  // The implicit interface step (coupling.scheme IMPLICIT; docs/fluid.md):
+  // advance() takes one step per call in which the element pressures are
+  // solved together with the crack's opening over the step, as the solid
+  // reported it with the geometry (CrackGeometry::opening_*). The acoustic
+  // step limit then does not apply; stable_dt() is the advective one.
+  bool implicit_interface = false;
   // Virtual opening (m) added to the crack's width at every node, grown ones
   // included: the fluid can always enter the closed crack ahead of its
   // front (a thin film instead of a lag). Without it a segment the crack

@@ -58,6 +58,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "hfmpm/exchange.hpp"
@@ -87,8 +88,28 @@ class FluidSolver {
   // crack is frozen meanwhile). Returns the number of substeps.
   int advance(double dt_total);
   // s, cfl * min(smallest particle length, smallest node spacing) / c, with
-  // c the fastest sound speed of the particles (>= sqrt(K / rho0)).
+  // c the fastest sound speed of the particles (>= sqrt(K / rho0)); with
+  // implicit_interface, c is the fastest particle speed (+inf at rest).
   double stable_dt() const;
+  // One implicit interface step of dt (implicit.cpp): the element pressures
+  // P_e over the step are solved so that each element's fluid, after the
+  // step's flow and inflow, fills the crack as the solid's reported response
+  // opens it under those pressures,
+  //   P_e = p_Tait(V_e(P) / V0_e),
+  //   w_i(t + dt) = w_i + dt (rate_i + dt (acceleration_i + sum_j C_ij p_j(P))),
+  // by Newton's method on a finite-difference Jacobian (banded, found by
+  // colouring). The fluid then moves under P, and the nodal pressures it
+  // reports are the ones the faces must carry over the same step. Needs the
+  // solid's response with the last set_crack(); throws std::logic_error
+  // without it, std::runtime_error if the step inverts a particle.
+  void step_implicit(double dt);
+  // Implicit interface: Pa, the largest difference at a wetted node between
+  // the pressure the faces carried over the last step and the fluid's
+  // pressure at the crack the solid then published (0 if consistent; the
+  // lumped response and contact make it differ). Newton's last residual, Pa.
+  double interface_mismatch() const { return interface_mismatch_; }
+  double interface_residual() const { return interface_residual_; }
+  int interface_iterations() const { return interface_iterations_; }
 
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
@@ -152,6 +173,16 @@ class FluidSolver {
   void merge_short();         // see FluidConfig::merge_fraction
   // output.cpp
   void project_pressure();
+  // Nodal pressures from particle pressures `pp` (the mass-weighted CPDI
+  // projection with the front, lag and boundary rules; see nodal_pressure()).
+  void project_pressure(const std::vector<double>& pp, std::vector<double>& nodal, std::vector<double>& scratch) const;
+  // implicit.cpp
+  struct Trial {
+    std::vector<double> pp, nodal, scratch, force, v, width, a, b, mass, volume, volume0;
+  };
+  // Residual P_e - p_Tait(V_e / V0_e) of element pressures P after a trial step of dt.
+  bool interface_trial(const std::vector<double>& P, double dt, Trial& t, std::vector<double>& residual) const;
+  void pressure_force(const std::vector<double>& pp, double mouth, std::vector<double>& force) const;
 
   FluidConfig config_;
   TaitEos eos_;
@@ -169,6 +200,13 @@ class FluidSolver {
   double injected_mass_ = 0, initial_mass_ = 0, outflow_mass_ = 0;
   double inlet_flux_ = 0;
   bool outlet_wetted_ = false;
+  // implicit interface
+  std::vector<double> wall_rate_, wall_acceleration_, wall_compliance_;  // from the solid (CrackGeometry)
+  std::size_t wall_band_ = 0;
+  std::vector<double> solved_;  // Pa, the element pressures of the last implicit step (the next start)
+  std::vector<std::vector<std::pair<std::size_t, double>>> pieces_;      // per particle: (element, fraction) now
+  double interface_mismatch_ = 0, interface_residual_ = 0;
+  int interface_iterations_ = 0;
 };
 
 }  // namespace hfmpm::fluid::mpm

@@ -54,6 +54,28 @@ class Solver {
   explicit Solver(SolidConfig config);
 
   void step(double dt);
+  // The step in two parts around an exchange with the fluid (the implicit
+  // interface scheme, docs/architecture.md): begin_step() does P2G and every
+  // load but the crack-face pressure (it needs no dt); step(dt) then finishes
+  // the step begun (or does a whole one). Between them set_crack_pressure()
+  // sets the pressure this step will carry, and face_response() says how the
+  // faces will move under it.
+  void begin_step();
+  bool step_begun() const { return step_begun_; }
+  // After begin_step(): per crack particle of crack c, the opening over the
+  // coming step of dt under face pressures p_j is
+  //   w_k + dt (rate_k + dt (acceleration_k + sum_j C_kj p_j)),
+  // exactly (the explicit update is affine in its load) while no contact
+  // acts and the normals turn little. rate: m/s, the faces' opening
+  // velocity now; acceleration: m/s^2, from every load but the face
+  // pressure; C: m/s^2 per Pa, banded, |k - j| <= band, row-major in
+  // compliance[k * (2 band + 1) + (j - k + band)]. Tips: 0 (their faces
+  // move together).
+  struct FaceResponse {
+    std::vector<double> rate, acceleration, compliance;
+    std::size_t band = 0;
+  };
+  FaceResponse face_response(std::size_t c) const;
   // cfl * h / (fastest P-wave speed with the scaled densities)
   double stable_dt() const;
 
@@ -125,7 +147,9 @@ class Solver {
   void g2p(double dt);
   // Cracks (solver_cracks.cpp)
   bool near_crack(const Vec2& x) const;
-  void crack_loads();
+  // Face loads: the in-situ traction the cut gives up (in_situ_reference) and
+  // the fluid's pressure, each when asked.
+  void crack_loads(bool in_situ, bool pressure);
   FaceShares face_shares(const Crack& crack, std::size_t k, int side) const;
   void spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force);
   void implicit_face_stiffness(double dt);
@@ -168,6 +192,7 @@ class Solver {
   std::vector<std::uint32_t> edges_[4];
   std::vector<double> lambda_, shear_, p_modulus_, density_;  // per material, density scaled
   std::uint32_t epoch_ = 0;
+  bool step_begun_ = false;  // begin_step() ran; step() finishes it
   double t_ = 0;
   std::uint64_t steps_ = 0;
   std::vector<int> face_slot_;  // scratch of implicit_face_stiffness: node -> entry, -1

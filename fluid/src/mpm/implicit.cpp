@@ -1,0 +1,345 @@
+// The implicit interface step (coupling.scheme IMPLICIT; docs/fluid.md,
+// "The implicit interface step").
+//
+// Why. Stepped explicitly against a frozen crack, a stiff fluid can take the
+// inflow of a step only by compressing: its pressure rises by about
+// K dt (dw/dt) / w over each step, a rise the crack faces never carry
+// (docs/stability.md, "The stiff-fluid lag"), and its own acoustic step is
+// sqrt(K) times shorter than the solid's. Here the fluid's pressure over a
+// step is instead solved together with the crack's opening over that step.
+//
+// The solid has done its P2G for the step and reported, per crack particle,
+// the opening rate r_i, the opening acceleration a_i from every load but the
+// face pressure, and the lumped compliance c_i (opening acceleration per Pa
+// of face pressure). With face pressures p_i over the step, its explicit
+// update opens node i to
+//   w_i' = w_i + dt (r_i + dt (a_i + c_i p_i)),
+// exactly for a uniform pressure while no contact acts (the response of an
+// explicit step is affine in its load). The unknowns are the element
+// pressures P_e (the fluid's element-constant pressure). A trial step with P
+// moves the fluid as step() does (CPDI P2G forces from P, implicit wall
+// friction, the corner update of every particle domain, the inlet's mass and
+// the wetted outlet) and opens the crack by the response above under the
+// nodal pressures P projects to; each element then holds fluid of volume V_e
+// and zero-pressure volume V0_e, and the residual is
+//   R_e(P) = P_e - p_Tait(V_e(P) / V0_e)   (p = 0 where J >= 1: no tension).
+// R is close to affine in P (exactly, but for the width floors, the moved
+// ends seeing the new widths and the no-tension cut), so Newton's method
+// with one finite-difference Jacobian converges in a few iterations. P_e
+// touches only the residuals of elements a few away, so the Jacobian is
+// banded: it is built from one trial per colour (elements kColours apart
+// perturbed together) and factorised sparse.
+//
+// For an incompressible fluid P is the Lagrange multiplier that makes the
+// crack's new volume hold the fluid it received; for a compressible one the
+// compression is part of the same balance. Either way the faces carry, over
+// the step, the pressure the fluid has at the step's end, and the step is
+// limited by the solid's CFL and the fluid's advection, not by K.
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "hfmpm/fluid/mpm/solver.hpp"
+
+namespace hfmpm::fluid::mpm {
+namespace {
+
+// Elements perturbed together when the Jacobian is built by differences: a
+// pressure reaches the residuals of elements at most kReach away (a particle
+// spans up to ~2 elements; its ends move with the nodes around it; the faces
+// open under the pressure projected to the nodes it touches).
+constexpr std::size_t kReach = 5;
+constexpr std::size_t kColours = 2 * kReach + 1;
+
+// The element pieces of a domain [a, b]: fn(element, fraction of the length).
+template <class Fn>
+void for_pieces(const std::vector<double>& arc, double a, double b, Fn&& fn) {
+  const std::size_t elements = arc.size() - 1;
+  const double l = b - a;
+  if (!(l > 0)) return;
+  const std::size_t first = hat_at(arc, a).node, last = hat_at(arc, b).node;
+  for (std::size_t e = first; e <= last && e < elements; ++e) {
+    const double lo = e == 0 ? a : std::max(a, arc[e]);
+    const double hi = e + 1 == elements ? b : std::min(b, arc[e + 1]);
+    if (hi > lo) fn(e, (hi - lo) / l);
+  }
+}
+
+double sum_squares(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m += x * x;
+  return std::sqrt(m);
+}
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+}  // namespace
+
+void FluidSolver::pressure_force(const std::vector<double>& pp, double mouth, std::vector<double>& force) const {
+  const auto& arc = grid_.arc();
+  const std::size_t n = grid_.size();
+  force.assign(n, 0.0);
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    if (!(pp[p] > 0)) continue;
+    const double a = particles_.start(p), b = particles_.end(p);
+    const HatPoint ha = hat_at(arc, a), hb = hat_at(arc, b);
+    const double fa = pp[p] * grid_.width_at(a), fb = pp[p] * grid_.width_at(b);
+    force[ha.node] -= fa * ha.n0;
+    force[ha.node + 1] -= fa * ha.n1;
+    force[hb.node] += fb * hb.n0;
+    force[hb.node + 1] += fb * hb.n1;
+  }
+  force[0] += mouth * grid_.width()[0];
+  if (outlet_wetted_) force[n - 1] -= std::max(0.0, config_.outlet.pressure(t_)) * grid_.width()[n - 1];
+}
+
+bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial& t,
+                                  std::vector<double>& residual) const {
+  const auto& arc = grid_.arc();
+  const auto& part = particles_;
+  const std::size_t n = grid_.size(), elements = n - 1, np = part.size();
+  const double rho0 = config_.density;
+  const auto& in = config_.inlet;
+  // Particle pressures from the element pressures, and what the faces carry.
+  t.pp.assign(np, 0.0);
+  for (std::size_t p = 0; p < np; ++p)
+    for (const auto& [e, f] : pieces_[p]) t.pp[p] += f * P[e];
+  project_pressure(t.pp, t.nodal, t.scratch);
+  // The fluid's momentum update under P (as p2g + grid_update).
+  pressure_force(t.pp, t.nodal[0], t.force);
+  t.v.assign(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (mass_[i] > 0) t.v[i] = (momentum_[i] + dt * t.force[i]) / (mass_[i] + dt * drag_[i]);
+  }
+  if (!config_.outlet.enabled) t.v.back() = std::min(0.0, t.v.back());
+  // The crack at the end of the step, opened by the solid's response to the nodal pressures.
+  const auto& crack = grid_.crack_width();
+  const auto& effective = grid_.width();
+  t.width.resize(n);
+  const std::size_t band = wall_band_, row = 2 * band + 1;
+  for (std::size_t i = 0; i < n; ++i) {
+    double load = 0;  // m/s^2, sum_j C_ij p_j
+    const std::size_t lo = i >= band ? i - band : 0, hi = std::min(n - 1, i + band);
+    for (std::size_t j = lo; j <= hi; ++j) load += wall_compliance_[i * row + j + band - i] * t.nodal[j];
+    const double opened = crack[i] + dt * (wall_rate_[i] + dt * (wall_acceleration_[i] + load));
+    t.width[i] = std::max(0.0, opened) + (effective[i] - crack[i]);  // + the virtual and pre-opening
+  }
+  // The particle domains at the end of the step (the CPDI corner update).
+  t.a.resize(np);
+  t.b.resize(np);
+  t.mass.assign(part.mass.begin(), part.mass.end());
+  for (std::size_t p = 0; p < np; ++p) {
+    t.a[p] = part.start(p) + dt * interpolate(arc, t.v, part.start(p));
+    t.b[p] = part.end(p) + dt * interpolate(arc, t.v, part.end(p));
+    if (!(t.b[p] > t.a[p])) return false;
+  }
+  // The inlet particle is re-extended to the mouth with the mass that crossed it (inlet()).
+  if (np > 0) {
+    if (in.kind == InletConfig::Kind::FlowRate) {
+      t.mass[0] += rho0 * 0.5 * (in.flow_rate(t_) + in.flow_rate(t_ + dt)) * dt;
+    } else if (t.a[0] > 0) {
+      const double p_in = std::max(0.0, in.pressure(t_ + dt));
+      t.mass[0] += rho0 / eos_.volume_ratio(p_in) * integrate(arc, t.width, 0.0, t.a[0]);
+    } else if (t.a[0] < 0) {
+      const double all = integrate(arc, t.width, t.a[0], t.b[0]), outside = integrate(arc, t.width, t.a[0], 0.0);
+      t.mass[0] -= t.mass[0] * (all > 0 ? outside / all : -t.a[0] / (t.b[0] - t.a[0]));
+    }
+    t.a[0] = 0;
+    if (!(t.b[0] > 0) || !(t.mass[0] > 0)) return false;
+    // A wetted outlet cuts the last particle at the end of the crack (outlet()).
+    if (outlet_wetted_) {
+      const std::size_t q = np - 1;
+      const double end = grid_.length();
+      if (t.b[q] > end) {
+        const double all = integrate(arc, t.width, t.a[q], t.b[q]), outside = integrate(arc, t.width, end, t.b[q]);
+        t.mass[q] -= t.mass[q] * (all > 0 ? outside / all : (t.b[q] - end) / (t.b[q] - t.a[q]));
+      } else if (t.b[q] < end) {
+        const double p_out = std::max(0.0, config_.outlet.pressure(t_ + dt));
+        t.mass[q] += rho0 / eos_.volume_ratio(p_out) * integrate(arc, t.width, t.b[q], end);
+      }
+      t.b[q] = end;
+      if (!(t.b[q] > t.a[q])) return false;
+    }
+  }
+  // Each element's fluid: its volume in the opened crack against its zero-pressure volume.
+  t.volume.assign(elements, 0.0);
+  t.volume0.assign(elements, 0.0);
+  for (std::size_t p = 0; p < np; ++p) {
+    const double v = integrate(arc, t.width, t.a[p], t.b[p]), v0 = t.mass[p] / rho0;
+    for_pieces(arc, t.a[p], t.b[p], [&](std::size_t e, double f) {
+      t.volume[e] += f * v;
+      t.volume0[e] += f * v0;
+    });
+  }
+  residual.resize(elements);
+  for (std::size_t e = 0; e < elements; ++e) {
+    // Volume strain the fluid leaves unfilled (> 0) or overfills (< 0) at
+    // its pressure P_e; an empty element never constrains P (g = 1).
+    residual[e] = t.volume0[e] > 0 ? t.volume[e] / t.volume0[e] - eos_.volume_ratio(P[e]) : 1.0;
+  }
+  return true;
+}
+
+void FluidSolver::step_implicit(double dt) {
+  if (grid_.empty()) throw std::logic_error("fluid: set_crack() must be called before step_implicit()");
+  if (!(dt > 0) || !std::isfinite(dt)) {
+    throw std::invalid_argument("fluid: step dt must be finite and > 0 s, got " + std::to_string(dt));
+  }
+  const std::size_t n = grid_.size(), elements = n - 1;
+  if (wall_rate_.size() != n || wall_acceleration_.size() != n || wall_compliance_.size() != n * (2 * wall_band_ + 1)) {
+    throw std::logic_error(
+        "fluid: the implicit interface step needs the solid's face response (CrackGeometry::opening_rate, "
+        "opening_acceleration, opening_compliance) with every crack; the last crack had none");
+  }
+  const double injected_before = injected_mass_;
+  interface_iterations_ = 0;
+  interface_residual_ = 0;
+  std::vector<double> faces;  // the pressures the faces carry over this step
+  if (particles_.size() > 0) {
+    if (config_.outlet.enabled && particles_.end(particles_.size() - 1) >= grid_.length()) outlet_wetted_ = true;
+    update_state();
+    p2g();  // mass, momentum and friction of the nodes; the force is the trial's
+    const auto& arc = grid_.arc();
+    const std::size_t np = particles_.size();
+    pieces_.assign(np, {});
+    std::vector<double> P(elements, 0.0), weight(elements, 0.0);
+    for (std::size_t p = 0; p < np; ++p) {
+      for_pieces(arc, particles_.start(p), particles_.end(p), [&](std::size_t e, double f) {
+        pieces_[p].push_back({e, f});
+        P[e] += f * particles_.mass[p] * particles_.pressure[p];
+        weight[e] += f * particles_.mass[p];
+      });
+    }
+    for (std::size_t e = 0; e < elements; ++e) P[e] = weight[e] > 0 ? P[e] / weight[e] : 0.0;
+    // Start from the last step's solution where there was fluid (the state's
+    // pressure differs from it by the mismatch of the solid's response).
+    for (std::size_t e = 0; e < std::min(elements, solved_.size()); ++e)
+      if (weight[e] > 0 && solved_[e] > 0) P[e] = solved_[e];
+    // The complementarity problem: P_e >= 0, g_e >= 0, P_e g_e = 0 (the
+    // fluid fills its element at its pressure, or cavitates at P = 0), in
+    // the min form Phi_e = min(P_e / K, g_e) = 0, by semismooth Newton:
+    // each iteration takes the rows of the active branch (P_e = 0 where
+    // P_e / K <= g_e, else the volume balance g_e = 0) with a fresh
+    // finite-difference Jacobian of g, and a backtracking line search on
+    // |Phi|. Stiff fluids live at the kink (J ~ 1), so the branch must be
+    // chosen per iteration, not fixed by a chord Jacobian.
+    Trial trial;
+    std::vector<double> g, g_probe, phi(elements), candidate(elements), phi_candidate(elements);
+    auto fail = [&](const char* what) {
+      std::ostringstream out;
+      out << "fluid: crack " << grid_.crack_id() << ": the implicit interface step of " << dt << " s " << what
+          << " (stable dt " << stable_dt() << " s); the step is too large";
+      throw std::runtime_error(out.str());
+    };
+    if (!interface_trial(P, dt, trial, g)) {
+      std::fill(P.begin(), P.end(), 0.0);  // no pressure moves no particle end far
+      if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out at zero pressure");
+    }
+    const double K = config_.bulk_modulus;
+    auto min_form = [&](const std::vector<double>& p, const std::vector<double>& gg, std::vector<double>& out) {
+      double sum = 0;
+      for (std::size_t e = 0; e < elements; ++e) {
+        out[e] = std::min(p[e] / K, gg[e]);
+        sum += out[e] * out[e];
+      }
+      return std::sqrt(sum);
+    };
+    // Tolerance: a volume strain of 1e-11 (K x 1e-11 in pressure: 0.02 Pa for water).
+    const double tolerance = 1e-11;
+    const double scale = std::max({max_abs(P), config_.lag_pressure, 1e-6 * K, 1.0});
+    const double delta = 1e-6 * scale;
+    Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(elements), static_cast<Eigen::Index>(elements));
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
+    double norm = min_form(P, g, phi);
+    for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
+      ++interface_iterations_;
+      for (auto& row : dg) row.clear();
+      std::vector<double> probe;
+      for (std::size_t colour = 0; colour < kColours && colour < elements; ++colour) {
+        probe = P;
+        for (std::size_t e = colour; e < elements; e += kColours) probe[e] += delta;
+        if (!interface_trial(probe, dt, trial, g_probe)) fail("turns a particle inside out while probing");
+        for (std::size_t row = 0; row < elements; ++row) {
+          const double d = (g_probe[row] - g[row]) / delta;
+          if (d == 0) continue;
+          // The perturbed element of this colour nearest the row (one lies within kReach).
+          const std::size_t r = (row % kColours + kColours - colour) % kColours;
+          const std::size_t col = r <= kReach ? row - r : row + (kColours - r);
+          if (col < elements) dg[row].push_back({col, d});
+        }
+      }
+      std::vector<Eigen::Triplet<double>> entries;
+      for (std::size_t e = 0; e < elements; ++e) {
+        const auto row = static_cast<Eigen::Index>(e);
+        if (P[e] / K <= g[e]) {
+          entries.emplace_back(row, row, 1.0 / K);
+        } else {
+          for (const auto& [col, d] : dg[e]) entries.emplace_back(row, static_cast<Eigen::Index>(col), d);
+        }
+      }
+      system.setFromTriplets(entries.begin(), entries.end());
+      lu.compute(system);
+      if (lu.info() != Eigen::Success) fail("gave a singular interface Jacobian");
+      Eigen::VectorXd rhs(static_cast<Eigen::Index>(elements));
+      for (std::size_t e = 0; e < elements; ++e) rhs[static_cast<Eigen::Index>(e)] = -phi[e];
+      const Eigen::VectorXd d = lu.solve(rhs);
+      double lambda = 1;
+      bool accepted = false;
+      for (int halving = 0; halving < 30; ++halving, lambda *= 0.5) {
+        for (std::size_t e = 0; e < elements; ++e)
+          candidate[e] = std::max(0.0, P[e] + lambda * d[static_cast<Eigen::Index>(e)]);
+        if (!interface_trial(candidate, dt, trial, g_probe)) continue;
+        const double candidate_norm = min_form(candidate, g_probe, phi_candidate);
+        if (candidate_norm < (1 - 1e-4 * lambda) * norm) {
+          P.swap(candidate);
+          g.swap(g_probe);
+          phi.swap(phi_candidate);
+          norm = candidate_norm;
+          accepted = true;
+          break;
+        }
+      }
+      if (std::getenv("HFMPM_DEBUG_NEWTON"))
+        std::fprintf(stderr, "  newton %d norm %g max %g lambda %g accepted %d\n", it, norm, max_abs(phi), lambda,
+                     accepted ? 1 : 0);
+      if (!accepted) break;
+    }
+    interface_residual_ = max_abs(phi) * K;  // Pa
+    if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out");
+    solved_ = P;
+    // Commit: the explicit update of step() under the solved pressures.
+    for (std::size_t p = 0; p < np; ++p) particles_.pressure[p] = trial.pp[p];
+    faces = trial.nodal;
+    force_ = trial.force;
+    grid_update(dt);
+    g2p(dt);
+  }
+  inlet(dt);
+  outlet(dt);
+  merge_short();
+  t_ += dt;
+  ++steps_;
+  inlet_flux_ = (injected_mass_ - injected_before) / (config_.density * dt);
+  if (faces.empty()) {
+    // Nothing flowed yet (or the first particle was just seeded): the state's pressure.
+    update_state();
+    project_pressure();
+  } else {
+    // The pressures the faces carry over the step just taken; the particles'
+    // own state follows from the crack the solid publishes next (set_crack).
+    nodal_pressure_ = std::move(faces);
+  }
+}
+
+}  // namespace hfmpm::fluid::mpm
