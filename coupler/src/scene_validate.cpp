@@ -175,6 +175,12 @@ std::vector<SceneProblem> validate(const scene::Scene& s) {
       check_mpm_fluid(c, s);
     }
   }
+  if (s.coupling().scheme() == scene::Coupling::IMPLICIT && s.has_fluid() && s.fluid().has_mpm() &&
+      s.has_solid() && !s.solid().has_mpm()) {
+    c.bad("coupling.scheme", "IMPLICIT",
+          "JACOBI or GAUSS_SEIDEL with this solid: the implicit scheme needs solid.mpm (the prescribed crack "
+          "reports no face response for the fluid's interface solve)");
+  }
   return c.take();
 }
 

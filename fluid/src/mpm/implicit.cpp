@@ -267,11 +267,22 @@ void FluidSolver::step_implicit(double dt) {
       for (auto& row : dg) row.clear();
       std::vector<double> probe;
       for (std::size_t colour = 0; colour < kColours && colour < elements; ++colour) {
+        // A forward difference, or a backward one where the forward probe
+        // squeezes a particle to nothing (P lies at the edge of the feasible set).
+        double step = delta;
         probe = P;
-        for (std::size_t e = colour; e < elements; e += kColours) probe[e] += delta;
-        if (!interface_trial(probe, dt, trial, g_probe)) fail("turns a particle inside out while probing");
+        for (std::size_t e = colour; e < elements; e += kColours) probe[e] += step;
+        if (!interface_trial(probe, dt, trial, g_probe)) {
+          step = -delta;
+          for (std::size_t e = colour; e < elements; e += kColours) probe[e] = std::max(0.0, P[e] + step);
+          if (!interface_trial(probe, dt, trial, g_probe)) fail("turns a particle inside out while probing");
+        }
         for (std::size_t row = 0; row < elements; ++row) {
-          const double d = (g_probe[row] - g[row]) / delta;
+          const std::size_t r0 = (row % kColours + kColours - colour) % kColours;
+          const std::size_t c0 = r0 <= kReach ? row - r0 : row + (kColours - r0);
+          const double moved = c0 < elements ? probe[c0] - P[c0] : 0.0;
+          if (moved == 0) continue;
+          const double d = (g_probe[row] - g[row]) / moved;
           if (d == 0) continue;
           // The perturbed element of this colour nearest the row (one lies within kReach).
           const std::size_t r = (row % kColours + kColours - colour) % kColours;

@@ -1,0 +1,99 @@
+// The faces' one-step response (Solver::begin_step / face_response), which the
+// implicit interface coupling gives the fluid (docs/architecture.md): an
+// explicit step is affine in its face load, so with the response reported
+// after begin_step() the opening after the step is known before it is taken,
+//   w_k' = w_k + dt (rate_k + dt (acceleration_k + sum_j C_kj p_j)).
+// - Any face pressure, uniform or not, on an open crack in motion: the
+//   prediction equals the step's opening to round-off (asserted to 1e-9 of
+//   the opening change; measured ~1e-14: exact but for round-off).
+// - Pressure at one crack particle moves only openings within the band, and
+//   the band is a few particles (the nodes of one side reach about a cell).
+// - Splitting a step (begin_step, then step) changes nothing: same particles
+//   after the step to the last bit.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "fracture_setup.hpp"
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+SolidConfig opened_edge_crack() {
+  SolidConfig c = edge_crack(1.0, 0.3, 0.75, 20, TimeFunction::constant(0));
+  c.implicit_face_stiffness = false;  // the implicit scheme sends no stiffness
+  c.threads = 1;
+  return c;
+}
+
+// Opening predicted for pressures p from the response after begin_step().
+std::vector<double> predicted(const Solver& s, const std::vector<double>& p, double dt) {
+  const auto r = s.face_response(0);
+  const auto& crack = s.cracks()[0];
+  const std::size_t n = crack.size(), row = 2 * r.band + 1;
+  std::vector<double> w(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    double load = 0;
+    for (std::size_t j = k >= r.band ? k - r.band : 0; j <= std::min(n - 1, k + r.band); ++j)
+      load += r.compliance[k * row + j + r.band - k] * p[j];
+    w[k] = crack.width(k) + dt * (r.rate[k] + dt * (r.acceleration[k] + load));
+  }
+  return w;
+}
+
+TEST(FaceResponse, PredictsTheOpeningOfTheNextStepForAnyPressure) {
+  Solver s(opened_edge_crack());
+  const std::size_t n = s.cracks()[0].size();
+  // Open the crack and leave it moving: a few steps under 1 MPa.
+  s.set_crack_pressure(0, std::vector<double>(n, 1e6));
+  const double dt = s.stable_dt();
+  for (int i = 0; i < 40; ++i) s.step(dt);
+  for (int variant = 0; variant < 3; ++variant) {
+    std::vector<double> p(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double x = static_cast<double>(k) / static_cast<double>(n - 1);
+      p[k] = variant == 0 ? 1e6 : variant == 1 ? 2e6 * (1 - x) : 1e6 * (1 + 0.5 * std::sin(12 * x));
+    }
+    s.begin_step();
+    const auto w_predicted = predicted(s, p, dt);
+    std::vector<double> before(n);
+    for (std::size_t k = 0; k < n; ++k) before[k] = s.cracks()[0].width(k);
+    s.set_crack_pressure(0, p);
+    s.step(dt);
+    double change = 0, error = 0;
+    for (std::size_t k = 0; k + 1 < n; ++k) {  // the tip stays closed
+      ASSERT_GT(s.cracks()[0].width(k), 0) << "the crack must stay open (no contact) for the check";
+      change = std::max(change, std::abs(s.cracks()[0].width(k) - before[k]));
+      error = std::max(error, std::abs(s.cracks()[0].width(k) - w_predicted[k]));
+    }
+    ASSERT_GT(change, 0);
+    std::printf("variant %d: opening change %.3e m, prediction error %.3e m\n", variant, change, error);
+    EXPECT_LT(error, 1e-9 * change) << "pressure variant " << variant << ": change " << change;
+  }
+}
+
+TEST(FaceResponse, IsBandedAndSplittingTheStepChangesNothing) {
+  Solver a(opened_edge_crack()), b(opened_edge_crack());
+  const std::size_t n = a.cracks()[0].size();
+  const double dt = a.stable_dt();
+  for (Solver* s : {&a, &b}) s->set_crack_pressure(0, std::vector<double>(n, 1e6));
+  for (int i = 0; i < 10; ++i) {
+    a.step(dt);
+    b.begin_step();
+    const auto r = b.face_response(0);
+    EXPECT_LE(r.band, 8u);
+    EXPECT_GE(r.band, 1u);
+    for (std::size_t k = 0; k + 1 < n; ++k) EXPECT_GT(r.compliance[k * (2 * r.band + 1) + r.band], 0) << k;
+    b.step(dt);
+  }
+  for (std::size_t p = 0; p < a.particles().size(); ++p) {
+    ASSERT_EQ(a.particles().x[p], b.particles().x[p]) << p;
+    ASSERT_EQ(a.particles().v[p], b.particles().v[p]) << p;
+  }
+}
+
+}  // namespace
+}  // namespace hfmpm::solid::mpm
