@@ -86,6 +86,16 @@ RunSummary Coupler::run() {
   manifest_.set_number("solid_compute_s", summary.solid_compute_s);
   if (sides_[1].expected) manifest_.set_number("fluid_compute_s", summary.fluid_compute_s);
   if (step_ > 0) manifest_.set_number("coupling_overhead_us_per_step", summary.overhead_per_step_us());
+  if (!dt_limit_steps_.empty()) {
+    // The step: time.safety_factor x the smaller side's stable step, chosen
+    // anew after every command; the term that set it for most steps.
+    const auto most = std::max_element(dt_limit_steps_.begin(), dt_limit_steps_.end(),
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    manifest_.set("dt_limited_by", most->first);
+    manifest_.set_number("dt_limited_by_fraction", static_cast<double>(most->second) / static_cast<double>(step_));
+    manifest_.set_number("dt_min_s", dt_min_);
+    manifest_.set_number("dt_max_s", dt_max_);
+  }
   if (energy_) {
     manifest_.set_number("inlet_work_j", energy_->inlet_work());
     manifest_.set_number("initial_fill_energy_j", energy_->initial_energy());

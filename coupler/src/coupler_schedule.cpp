@@ -90,6 +90,7 @@ void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelop
   if (envelope.has_ready() && !side.ready) {
     side.ready = true;
     side.stable_dt = envelope.ready().stable_dt();
+    side.stable_dt_limit = envelope.ready().stable_dt_limit().substr(0, 200);
     side.diagnostics = proto::from_proto(envelope.ready().diagnostics());
     return;
   }
@@ -115,7 +116,10 @@ double Coupler::next_dt() {
       throw RunFailure{"the " + side.name + " side reported a stable time step of " + std::to_string(side.stable_dt) +
                        " s" + at_step() + "; it must be > 0"};
     }
-    stable = std::min(stable, side.stable_dt);
+    if (side.stable_dt < stable) {
+      stable = side.stable_dt;
+      dt_limit_ = side.name + (side.stable_dt_limit.empty() ? std::string() : ": " + side.stable_dt_limit);
+    }
   }
   if (!std::isfinite(stable)) throw RunFailure{"neither side reports a finite stable time step"};
   return scene_.time().safety_factor() * stable;
@@ -178,9 +182,13 @@ void Coupler::step_loop(RunSummary& summary) {
     ++summary.commands;
     step_ += n;
     t_ = t_expected;
+    dt_limit_steps_[dt_limit_] += n;
+    dt_min_ = std::min(dt_min_, dt);
+    dt_max_ = std::max(dt_max_, dt);
     for (auto& side : sides_) {
       if (!side.expected) continue;
       side.stable_dt = side.report->stable_dt();
+      side.stable_dt_limit = side.report->stable_dt_limit().substr(0, 200);
       side.diagnostics = proto::from_proto(side.report->diagnostics());
       side.compute_s += side.report->compute_s();
       side.exchange_s += side.report->exchange_s();

@@ -16,6 +16,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -57,6 +58,7 @@ struct Side {
   std::uint64_t heartbeat_step = 0;
   bool waiting_for_peer = false;
   double stable_dt = kInf;
+  std::string stable_dt_limit;  // what the side says sets its stable_dt
   SideDiagnostics diagnostics;
   std::optional<protocol::StepReport> report;
   std::string data_endpoint;
@@ -136,6 +138,9 @@ class Coupler {
   bool stopped_at_max_steps_ = false;
   // Largest fluid pressure change at frozen crack width over a report, and when (run.json).
   double max_coupling_lag_ = 0, max_coupling_lag_t_ = 0;
+  std::string dt_limit_;                              // "side: term" that set the last step
+  std::map<std::string, std::uint64_t> dt_limit_steps_;  // steps taken under each limit
+  double dt_min_ = kInf, dt_max_ = 0;
   Log log_;
   Progress progress_;
   microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};

@@ -208,6 +208,7 @@ class SideRuntime {
     }
     protocol::Envelope ready;
     ready.mutable_ready()->set_stable_dt(model_.stable_dt());
+    ready.mutable_ready()->set_stable_dt_limit(model_.stable_dt_limit());
     proto::to_proto(model_.diagnostics(), ready.mutable_ready()->mutable_diagnostics());
     send(control_, ready);
   }
@@ -289,6 +290,7 @@ class SideRuntime {
     report->set_step(step_);
     report->set_t(t_);
     report->set_stable_dt(model_.stable_dt());
+    report->set_stable_dt_limit(model_.stable_dt_limit());
     report->set_status(protocol::StepReport::OK);
     proto::to_proto(model_.diagnostics(), report->mutable_diagnostics());
     report->set_compute_s(compute_s);

@@ -40,6 +40,12 @@ class MpmFluidSide final : public coupling::SideModel {
     return dt;
   }
 
+  std::string stable_dt_limit() const override {
+    return config_.implicit_interface
+               ? "advection, cfl l / |v| (fluid.mpm.cfl = " + std::to_string(config_.cfl) + ")"
+               : "sound speed, max_substeps x cfl l / c (fluid.mpm.cfl = " + std::to_string(config_.cfl) + ")";
+  }
+
   void advance(double dt) override {
     for (auto& c : cracks_) substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
   }

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <cstdio>
-#include <cstdlib>
 #include <optional>
 
 #include "hfmpm/output/frame_writer.hpp"
@@ -52,32 +50,16 @@ class MpmSolidSide final : public coupling::SideModel {
     }
   }
   double stable_dt() const override { return solver_->stable_dt(); }
+  std::string stable_dt_limit() const override {
+    return "P-wave CFL, cfl h / c_p (solid.mpm.cfl = " + std::to_string(solver_->config().cfl) + ")";
+  }
   void advance(double dt) override {
     for (std::size_t c = 0; c < prescribed_.size(); ++c) {
       if (!prescribed_[c]) continue;
       const double p = (*prescribed_[c])(solver_->time());
       solver_->set_crack_pressure(c, std::vector<double>(solver_->cracks()[c].size(), p));
     }
-    std::vector<double> predicted;
-    const bool debug = implicit_ && std::getenv("HFMPM_DEBUG_RESPONSE") && solver_->step_begun() && !solver_->cracks().empty();
-    if (debug) {
-      const auto& crack = solver_->cracks()[0];
-      const auto r = solver_->face_response(0);
-      const std::size_t n = crack.size(), row = 2 * r.band + 1;
-      for (std::size_t k = 0; k < n; ++k) {
-        double load = 0;
-        for (std::size_t j = k >= r.band ? k - r.band : 0; j <= std::min(n - 1, k + r.band); ++j)
-          load += r.compliance[k * row + j + r.band - k] * crack.face_pressure(j);
-        predicted.push_back(crack.width(k) + dt * (r.rate[k] + dt * (r.acceleration[k] + load)));
-      }
-    }
     solver_->step(dt);
-    if (debug && solver_->steps() < 5) {
-      const auto& crack = solver_->cracks()[0];
-      std::fprintf(stderr, "solid step %lu contacts %lu\n", (unsigned long)solver_->steps(), (unsigned long)solver_->contacts());
-      for (std::size_t k = 0; k < predicted.size() && k < crack.size(); ++k)
-        std::fprintf(stderr, "  %zu predicted %.4e actual %.4e p %.1f\n", k, predicted[k], crack.width(k), crack.face_pressure(k));
-    }
   }
   void publish(protocol::DataFrame& frame) override {
     auto* state = frame.mutable_crack();

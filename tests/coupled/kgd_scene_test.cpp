@@ -189,5 +189,67 @@ TEST(KgdScene, ToughnessCiSceneFollowsTheKVertex) {
                           [](double t) { return k_vertex(1e7, 0.25, 25e3, 8.3e-4, t); });
 }
 
+// The implicit interface scheme (coupling.scheme IMPLICIT, issue 17) on the
+// CI viscosity scene at its own step: the answer no longer depends on how
+// stiff the fluid is. At K = 2e7 Pa and water (2e9 Pa), from three notch
+// lengths on, the mouth opening, the net inlet pressure and the fluid front
+// agree within 2% at every row where the two tips have grown equally, and
+// within 3% where one tip is a growth increment (0.5 cell, 0.0175 m) ahead
+// (each growth step dips the pressure for a while); the tips differ by at
+// most one increment plus 2%. Against the M-vertex, water's opening is
+// within 10% and its net pressure within 20% (the CI bounds). Measured: at
+// equal tips 1.35% (opening) and 1.71% (pressure) worst, at unequal tips
+// 1.83% and 2.04%; fronts 1.6%; water against the M-vertex 1.2% and 3.6%. (The tip's half-length runs 7-16% long, its fluid front
+// 3-8%, at h = 0.035 m; 6-9% and 4-6% at h = 0.025 m: a spatial error and
+// the notch's memory, docs/verification.md; not asserted here.) K = 2e6 Pa
+// is left out on purpose: at 1.1e5 Pa it is compressed by 5%, a physical
+// difference (its opening is 2.3% smaller).
+TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
+  struct Run {
+    std::vector<double> t, length, front, mouth, p_in;
+  };
+  auto run_at = [](const char* bulk_modulus) {
+    const auto out = scratch_dir(std::string("kgd_implicit_") + bulk_modulus);
+    const auto result = run_scene(read_file(source("scenarios/kgd-viscosity-ci.scene")), out,
+                                  {"--set", "output.hdf5=false", "--set", "coupling.scheme=IMPLICIT", "--set",
+                                   std::string("fluid.mpm.bulk_modulus_pa=") + bulk_modulus},
+                                  900);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    const Csv h = read_csv(out + "/history.csv");
+    return Run{h.values("time_s"), h.values("crack_length_m"), h.values("front_position_m"),
+               h.values("mouth_opening_m"), h.values("inlet_pressure_pa")};
+  };
+  const Run soft = run_at("2e7"), water = run_at("2e9");
+  ASSERT_EQ(soft.t.size(), water.t.size());
+  ASSERT_GE(water.t.size(), 20u);
+  constexpr double kSigma0 = 1e5, kNotch = 0.15, kGrowth = 0.0175;
+  double worst_opening = 0, worst_pressure = 0, worst_front = 0;
+  int compared = 0;
+  for (std::size_t i = 0; i < water.t.size(); ++i) {
+    ASSERT_NEAR(soft.t[i], water.t[i], 1e-9);
+    if (std::min(soft.length[i], water.length[i]) < 3 * kNotch) continue;
+    const double opening = std::abs(soft.mouth[i] / water.mouth[i] - 1);
+    const double pressure = std::abs((soft.p_in[i] - kSigma0) / (water.p_in[i] - kSigma0) - 1);
+    const double front = std::abs(soft.front[i] / water.front[i] - 1);
+    std::printf("t %.2f s: K = 2e7 against water: opening %.4f, net pressure %.4f, front %.4f, tip %.4f m\n",
+                water.t[i], opening, pressure, front, soft.length[i] - water.length[i]);
+    const double bound = std::abs(soft.length[i] - water.length[i]) < 0.5 * kGrowth ? 0.02 : 0.03;
+    EXPECT_LT(opening, bound) << "t = " << water.t[i];
+    EXPECT_LT(pressure, bound) << "t = " << water.t[i];
+    EXPECT_LT(front, 0.02) << "t = " << water.t[i];
+    EXPECT_LT(std::abs(soft.length[i] - water.length[i]), kGrowth + 0.02 * water.length[i]) << "t = " << water.t[i];
+    const Vertex v = m_vertex(1e7, 0.25, 0.01, 2.5e-4, water.t[i] - 0.025);
+    EXPECT_LT(std::abs(water.mouth[i] / v.opening - 1), 0.10) << "t = " << water.t[i];
+    EXPECT_LT(std::abs((water.p_in[i] - kSigma0) / v.pressure - 1), 0.20) << "t = " << water.t[i];
+    worst_opening = std::max(worst_opening, opening);
+    worst_pressure = std::max(worst_pressure, pressure);
+    worst_front = std::max(worst_front, front);
+    ++compared;
+  }
+  std::printf("%d rows: worst difference opening %.4f, net pressure %.4f, front %.4f\n", compared, worst_opening,
+              worst_pressure, worst_front);
+  EXPECT_GE(compared, 5);
+}
+
 }  // namespace
 }  // namespace hfmpm::test

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -68,11 +66,6 @@ void FluidSolver::set_crack(const CrackGeometry& crack) {
     for (std::size_t i = first; i < end && particles_.size() > 0; ++i) {
       if (grid_.arc()[i] > front) break;
       interface_mismatch_ = std::max(interface_mismatch_, std::abs(nodal_pressure_[i] - carried[i]));
-    }
-    if (std::getenv("HFMPM_DEBUG_MISMATCH") && steps_ % std::atoi(std::getenv("HFMPM_DEBUG_MISMATCH")) == 0) {
-      std::fprintf(stderr, "step %lu t %g front %g newton %d residual %g\n", (unsigned long)steps_, t_, front, interface_iterations_, interface_residual_);
-      for (std::size_t i = 0; i < n && i < carried.size(); ++i)
-        std::fprintf(stderr, "  %zu s=%.4f w=%.3e carried=%.1f state=%.1f\n", i, grid_.arc()[i], grid_.crack_width()[i], carried[i], nodal_pressure_[i]);
     }
   }
 }

@@ -30,6 +30,8 @@ class SideModel {
   // Once, with the validated scene; throws InputError for anything it cannot run.
   virtual void setup(const scene::Scene& scene, const std::string& output_dir) = 0;
   virtual double stable_dt() const = 0;  // s; +inf if unlimited
+  // What sets stable_dt() now, in a few words (run.json names the term that limited the step).
+  virtual std::string stable_dt_limit() const { return {}; }
   virtual void advance(double dt) = 0;   // one explicit step
   // Fill the payload of the frame this side sends (crack for a solid, fluid for a fluid).
   virtual void publish(protocol::DataFrame& frame) = 0;

@@ -179,6 +179,7 @@ class FluidSolver {
   // implicit.cpp
   struct Trial {
     std::vector<double> pp, nodal, scratch, force, v, width, a, b, mass, volume, volume0;
+    std::ptrdiff_t squeezed = -1;  // a particle the step turned inside out (the trial failed), or -1
   };
   // Residual P_e - p_Tait(V_e / V0_e) of element pressures P after a trial step of dt.
   bool interface_trial(const std::vector<double>& P, double dt, Trial& t, std::vector<double>& residual) const;
@@ -207,6 +208,7 @@ class FluidSolver {
   std::vector<std::vector<std::pair<std::size_t, double>>> pieces_;      // per particle: (element, fraction) now
   double interface_mismatch_ = 0, interface_residual_ = 0;
   int interface_iterations_ = 0;
+  std::uint64_t interface_merges_ = 0;  // particles merged because a step would have squeezed them
 };
 
 }  // namespace hfmpm::fluid::mpm
