@@ -1,6 +1,7 @@
 #include "mpm_fluid_side.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <set>
@@ -93,6 +94,20 @@ class MpmFluidSide final : public coupling::SideModel {
                                      ", which fluid.mpm.crack_ids lists");
         }
       }
+    }
+  }
+
+  void finish() override {
+    for (const auto& c : cracks_) {
+      const auto& s = c.solver;
+      if (!config_.implicit_interface || s.steps() == 0) continue;
+      std::fprintf(stderr,
+                   "hfmpm-fluid: crack %u: %llu implicit steps, %.2f Newton iterations per step, %llu stopped above "
+                   "tolerance, %llu particles merged before a step\n",
+                   c.id, static_cast<unsigned long long>(s.steps()),
+                   static_cast<double>(s.interface_newton_total()) / static_cast<double>(s.steps()),
+                   static_cast<unsigned long long>(s.interface_unconverged_steps()),
+                   static_cast<unsigned long long>(s.interface_merges()));
     }
   }
 

@@ -71,6 +71,14 @@ void to_proto(const CrackGeometry& crack, protocol::CrackState::Crack* out) {
   out->mutable_opening_acceleration()->Add(crack.opening_acceleration.begin(), crack.opening_acceleration.end());
   out->mutable_opening_compliance()->Add(crack.opening_compliance.begin(), crack.opening_compliance.end());
   out->set_opening_compliance_band(crack.compliance_band);
+  for (const auto& v : crack.plane_rate) {
+    out->add_plane_rate_x(v.x());
+    out->add_plane_rate_y(v.y());
+  }
+  for (const auto& a : crack.plane_acceleration) {
+    out->add_plane_acceleration_x(a.x());
+    out->add_plane_acceleration_y(a.y());
+  }
 }
 
 CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
@@ -92,6 +100,10 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
   check_unique_ids(type, id, crack.ids());
   const bool response = crack.opening_rate_size() > 0 || crack.opening_acceleration_size() > 0 ||
                         crack.opening_compliance_size() > 0;
+  if (!response && (crack.plane_rate_x_size() > 0 || crack.plane_rate_y_size() > 0 ||
+                    crack.plane_acceleration_x_size() > 0 || crack.plane_acceleration_y_size() > 0)) {
+    fail(type, id, "plane_rate / plane_acceleration come only with the opening_* response arrays");
+  }
   if (response) {
     check_length(type, id, "opening_rate", crack.opening_rate(), n);
     check_length(type, id, "opening_acceleration", crack.opening_acceleration(), n);
@@ -111,6 +123,17 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
     check_finite(type, id, "opening_rate", crack.opening_rate());
     check_finite(type, id, "opening_acceleration", crack.opening_acceleration());
     check_finite(type, id, "opening_compliance", crack.opening_compliance());
+    if (crack.plane_rate_x_size() > 0 || crack.plane_rate_y_size() > 0 || crack.plane_acceleration_x_size() > 0 ||
+        crack.plane_acceleration_y_size() > 0) {
+      check_length(type, id, "plane_rate_x", crack.plane_rate_x(), n);
+      check_length(type, id, "plane_rate_y", crack.plane_rate_y(), n);
+      check_length(type, id, "plane_acceleration_x", crack.plane_acceleration_x(), n);
+      check_length(type, id, "plane_acceleration_y", crack.plane_acceleration_y(), n);
+      check_finite(type, id, "plane_rate_x", crack.plane_rate_x());
+      check_finite(type, id, "plane_rate_y", crack.plane_rate_y());
+      check_finite(type, id, "plane_acceleration_x", crack.plane_acceleration_x());
+      check_finite(type, id, "plane_acceleration_y", crack.plane_acceleration_y());
+    }
   }
 
   CrackGeometry out;
@@ -122,6 +145,10 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
   out.opening_acceleration.assign(crack.opening_acceleration().begin(), crack.opening_acceleration().end());
   out.opening_compliance.assign(crack.opening_compliance().begin(), crack.opening_compliance().end());
   out.compliance_band = response ? crack.opening_compliance_band() : 0;
+  for (int i = 0; response && i < crack.plane_rate_x_size(); ++i) {
+    out.plane_rate.emplace_back(crack.plane_rate_x(i), crack.plane_rate_y(i));
+    out.plane_acceleration.emplace_back(crack.plane_acceleration_x(i), crack.plane_acceleration_y(i));
+  }
   out.position.resize(static_cast<std::size_t>(n));
   out.normal.resize(static_cast<std::size_t>(n));
   out.tip.resize(static_cast<std::size_t>(n));

@@ -74,6 +74,8 @@ class MpmSolidSide final : public coupling::SideModel {
         g.opening_acceleration = std::move(r.acceleration);
         g.opening_compliance = std::move(r.compliance);
         g.compliance_band = static_cast<std::uint32_t>(r.band);
+        g.plane_rate = std::move(r.plane_rate);
+        g.plane_acceleration = std::move(r.plane_acceleration);
       }
       g.grew = published_[c] != 0 && crack.size() > published_[c];
       published_[c] = crack.size();

@@ -177,12 +177,21 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
       if (!(t.b[q] > t.a[q])) return false;
     }
   }
+  // The crack moves along itself and carries the fluid (set_crack maps the
+  // particles the same way when the solid publishes the crack).
+  const auto& end_arc = predicted_arc_.size() == n ? predicted_arc_ : arc;
+  if (&end_arc != &arc) {
+    for (std::size_t p = 0; p < np; ++p) {
+      t.a[p] = map_arc(t.a[p], arc, end_arc);
+      t.b[p] = map_arc(t.b[p], arc, end_arc);
+    }
+  }
   // Each element's fluid: its volume in the opened crack against its zero-pressure volume.
   t.volume.assign(elements, 0.0);
   t.volume0.assign(elements, 0.0);
   for (std::size_t p = 0; p < np; ++p) {
-    const double v = integrate(arc, t.width, t.a[p], t.b[p]), v0 = t.mass[p] / rho0;
-    for_pieces(arc, t.a[p], t.b[p], [&](std::size_t e, double f) {
+    const double v = integrate(end_arc, t.width, t.a[p], t.b[p]), v0 = t.mass[p] / rho0;
+    for_pieces(end_arc, t.a[p], t.b[p], [&](std::size_t e, double f) {
       t.volume[e] += f * v;
       t.volume0[e] += f * v0;
     });
@@ -208,6 +217,21 @@ void FluidSolver::step_implicit(double dt) {
         "opening_acceleration, opening_compliance) with every crack; the last crack had none");
   }
   const double injected_before = injected_mass_;
+  // Where the nodes will be at the end of the step (the plane's own motion).
+  predicted_arc_.clear();
+  if (config_.implicit_interface && wall_plane_rate_.size() == n && wall_plane_acceleration_.size() == n &&
+      config_.implicit_interface) {
+    std::vector<Vec2> x(n);
+    for (std::size_t i = 0; i < n; ++i)
+      x[i] = grid_.position()[i] + dt * (wall_plane_rate_[i] + dt * wall_plane_acceleration_[i]);
+    predicted_arc_ = arc_length(x);
+    for (std::size_t i = 1; i < n; ++i) {
+      if (!(predicted_arc_[i] > predicted_arc_[i - 1])) {  // a step that folds the crack: keep it still
+        predicted_arc_ = grid_.arc();
+        break;
+      }
+    }
+  }
   interface_iterations_ = 0;
   interface_residual_ = 0;
   std::vector<double> faces;  // the pressures the faces carry over this step
@@ -275,6 +299,13 @@ void FluidSolver::step_implicit(double dt) {
       Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
       std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
       double norm = min_form(P, g, phi);
+      // The best iterate so far: the branch changes make the merit
+      // non-monotone, so a step that raises it is still taken when no
+      // shorter one lowers it (the active set must be allowed to change),
+      // and the best iterate is the answer.
+      std::vector<double> best_P = P, best_g = g, best_phi = phi;
+      double best_norm = norm;
+      int uphill = 0;
       for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
         ++interface_iterations_;
         for (auto& row : dg) row.clear();
@@ -327,11 +358,19 @@ void FluidSolver::step_implicit(double dt) {
         const Eigen::VectorXd d = lu.solve(rhs);
         double lambda = 1;
         bool accepted = false;
+        std::vector<double> first_P, first_g, first_phi;  // the longest feasible step
+        double first_norm = 0;
         for (int halving = 0; halving < 30; ++halving, lambda *= 0.5) {
           for (std::size_t e = 0; e < elements; ++e)
             candidate[e] = std::max(0.0, P[e] + lambda * d[static_cast<Eigen::Index>(e)]);
           if (!interface_trial(candidate, dt, trial, g_probe)) continue;
           const double candidate_norm = min_form(candidate, g_probe, phi_candidate);
+          if (first_P.empty()) {
+            first_P = candidate;
+            first_g = g_probe;
+            first_phi = phi_candidate;
+            first_norm = candidate_norm;
+          }
           if (candidate_norm < (1 - 1e-4 * lambda) * norm) {
             P.swap(candidate);
             g.swap(g_probe);
@@ -341,9 +380,28 @@ void FluidSolver::step_implicit(double dt) {
             break;
           }
         }
-          if (!accepted) break;
+        if (!accepted && !first_P.empty() && uphill < 10) {
+          ++uphill;
+          P.swap(first_P);
+          g.swap(first_g);
+          phi.swap(first_phi);
+          norm = first_norm;
+          accepted = true;
+        }
+        if (norm < best_norm) {
+          best_P = P;
+          best_g = g;
+          best_phi = phi;
+          best_norm = norm;
+        }
+        if (!accepted) break;
       }
+      P.swap(best_P);
+      g.swap(best_g);
+      phi.swap(best_phi);
       interface_residual_ = max_abs(phi) * K;  // Pa
+      interface_newton_ += static_cast<std::uint64_t>(interface_iterations_);
+      if (max_abs(phi) > tolerance) ++interface_unconverged_;
       if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out");
       solved_ = P;
         // Commit: the explicit update of step() under the solved pressures.

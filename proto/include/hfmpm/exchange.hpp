@@ -30,6 +30,9 @@ struct CrackGeometry {
   std::vector<double> opening_acceleration;  // m/s^2, all loads but the face pressure
   std::vector<double> opening_compliance;    // m/s^2 per Pa, size() (2 band + 1)
   std::uint32_t compliance_band = 0;
+  // Optional with the response: the crack plane's motion, x(t + dt) = x + dt (plane_rate + dt plane_acceleration).
+  std::vector<Vec2> plane_rate;          // m/s
+  std::vector<Vec2> plane_acceleration;  // m/s^2
 
   std::size_t size() const { return ids.size(); }
 };

@@ -185,6 +185,8 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
   FaceResponse out;
   out.rate.assign(count, 0.0);
   out.acceleration.assign(count, 0.0);
+  out.plane_rate.assign(count, Vec2::Zero());
+  out.plane_acceleration.assign(count, Vec2::Zero());
   // Each surface moves with the mass-weighted velocity of its side's nodes
   // (move_crack_surfaces); collect its weights first, then the band.
   struct Read {
@@ -193,8 +195,9 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
   };
   std::vector<std::vector<Read>> reads(count);
   for (std::size_t k = 0; k < count; ++k) {
-    if (tip(k)) continue;  // both surfaces of a tip move together: no opening
     const Vec2 n = crack.normal(k);
+    double side_mass[2] = {0, 0};
+    Vec2 side_v[2] = {Vec2::Zero(), Vec2::Zero()}, side_a[2] = {Vec2::Zero(), Vec2::Zero()};
     for (int s = 0; s < 2; ++s) {
       const int side = s == 0 ? 1 : -1;
       double mass = 0;
@@ -213,9 +216,25 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
         mine.push_back({key(nd, f), w * m});
       });
       if (!(mass > 0)) continue;
+      side_mass[s] = mass;
+      side_v[s] = v_sum / mass;
+      side_a[s] = a_sum / mass;
+      if (tip(k)) continue;  // both surfaces of a tip move together: no opening
       out.rate[k] += side * v_sum.dot(n) / mass;
       out.acceleration[k] += side * a_sum.dot(n) / mass;
       for (auto& r : mine) reads[k].push_back({r.key, side * r.weight / mass});
+    }
+    // The plane is the mean of the surfaces (Crack::update_plane); a tip's
+    // surfaces move with their joint momentum (move_crack_surfaces).
+    if (tip(k)) {
+      const double m = side_mass[0] + side_mass[1];
+      if (m > 0) {
+        out.plane_rate[k] = (side_mass[0] * side_v[0] + side_mass[1] * side_v[1]) / m;
+        out.plane_acceleration[k] = (side_mass[0] * side_a[0] + side_mass[1] * side_a[1]) / m;
+      }
+    } else {
+      out.plane_rate[k] = 0.5 * (side_v[0] + side_v[1]);
+      out.plane_acceleration[k] = 0.5 * (side_a[0] + side_a[1]);
     }
   }
   // The band: C_kj = d(opening acceleration at k) / d(pressure at j).

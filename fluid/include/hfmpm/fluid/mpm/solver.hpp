@@ -70,6 +70,11 @@
 
 namespace hfmpm::fluid::mpm {
 
+// Arc length s on the grid `from` carried to the grid `to` (same node
+// count): the same fraction of its element; beyond the ends, shifted with
+// the end node.
+double map_arc(double s, const std::vector<double>& from, const std::vector<double>& to);
+
 class FluidSolver {
  public:
   // Throws std::invalid_argument naming a config field that is out of range.
@@ -110,6 +115,11 @@ class FluidSolver {
   double interface_mismatch() const { return interface_mismatch_; }
   double interface_residual() const { return interface_residual_; }
   int interface_iterations() const { return interface_iterations_; }
+  // Over the run: Newton iterations, steps that stopped above the tolerance
+  // (their best iterate was taken), particles merged before a step.
+  std::uint64_t interface_newton_total() const { return interface_newton_; }
+  std::uint64_t interface_unconverged_steps() const { return interface_unconverged_; }
+  std::uint64_t interface_merges() const { return interface_merges_; }
 
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
@@ -204,11 +214,15 @@ class FluidSolver {
   // implicit interface
   std::vector<double> wall_rate_, wall_acceleration_, wall_compliance_;  // from the solid (CrackGeometry)
   std::size_t wall_band_ = 0;
+  std::vector<Vec2> wall_plane_rate_, wall_plane_acceleration_;  // the crack plane's motion (may be empty)
+  std::vector<double> predicted_arc_;                             // node arc lengths at the end of the step
   std::vector<double> solved_;  // Pa, the element pressures of the last implicit step (the next start)
   std::vector<std::vector<std::pair<std::size_t, double>>> pieces_;      // per particle: (element, fraction) now
   double interface_mismatch_ = 0, interface_residual_ = 0;
   int interface_iterations_ = 0;
-  std::uint64_t interface_merges_ = 0;  // particles merged because a step would have squeezed them
+  std::uint64_t interface_merges_ = 0;      // particles merged because a step would have squeezed them
+  std::uint64_t interface_newton_ = 0;      // Newton iterations over the run
+  std::uint64_t interface_unconverged_ = 0;  // steps whose solve stopped above its tolerance
 };
 
 }  // namespace hfmpm::fluid::mpm

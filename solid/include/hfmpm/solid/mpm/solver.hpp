@@ -71,9 +71,13 @@ class Solver {
   // pressure; C: m/s^2 per Pa, banded, |k - j| <= band, row-major in
   // compliance[k * (2 band + 1) + (j - k + band)]. Tips: 0 (their faces
   // move together).
+  // plane_rate / plane_acceleration: the crack plane's own motion (the mean
+  // of its two surfaces; m/s, m/s^2 from every load but the face pressure),
+  // so that the fluid can follow the crack as it moves along itself.
   struct FaceResponse {
     std::vector<double> rate, acceleration, compliance;
     std::size_t band = 0;
+    std::vector<Vec2> plane_rate, plane_acceleration;
   };
   FaceResponse face_response(std::size_t c) const;
   // cfl * h / (fastest P-wave speed with the scaled densities)
