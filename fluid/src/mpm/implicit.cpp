@@ -299,13 +299,9 @@ void FluidSolver::step_implicit(double dt) {
       Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
       std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
       double norm = min_form(P, g, phi);
-      // The best iterate so far: the branch changes make the merit
-      // non-monotone, so a step that raises it is still taken when no
-      // shorter one lowers it (the active set must be allowed to change),
-      // and the best iterate is the answer.
+      // The best iterate so far is the answer.
       std::vector<double> best_P = P, best_g = g, best_phi = phi;
       double best_norm = norm;
-      int uphill = 0;
       for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
         ++interface_iterations_;
         for (auto& row : dg) row.clear();
@@ -358,19 +354,11 @@ void FluidSolver::step_implicit(double dt) {
         const Eigen::VectorXd d = lu.solve(rhs);
         double lambda = 1;
         bool accepted = false;
-        std::vector<double> first_P, first_g, first_phi;  // the longest feasible step
-        double first_norm = 0;
         for (int halving = 0; halving < 30; ++halving, lambda *= 0.5) {
           for (std::size_t e = 0; e < elements; ++e)
             candidate[e] = std::max(0.0, P[e] + lambda * d[static_cast<Eigen::Index>(e)]);
           if (!interface_trial(candidate, dt, trial, g_probe)) continue;
           const double candidate_norm = min_form(candidate, g_probe, phi_candidate);
-          if (first_P.empty()) {
-            first_P = candidate;
-            first_g = g_probe;
-            first_phi = phi_candidate;
-            first_norm = candidate_norm;
-          }
           if (candidate_norm < (1 - 1e-4 * lambda) * norm) {
             P.swap(candidate);
             g.swap(g_probe);
@@ -379,14 +367,6 @@ void FluidSolver::step_implicit(double dt) {
             accepted = true;
             break;
           }
-        }
-        if (!accepted && !first_P.empty() && uphill < 10) {
-          ++uphill;
-          P.swap(first_P);
-          g.swap(first_g);
-          phi.swap(first_phi);
-          norm = first_norm;
-          accepted = true;
         }
         if (norm < best_norm) {
           best_P = P;
