@@ -2,6 +2,7 @@
 """The full stability sweep: extreme but valid inputs, each run checked, one summary table.
 
     /usr/bin/python3 tools/stability_sweep.py [--out DIR] [--bin DIR] [--only NAME...] [--jobs N] [--force]
+        [--set KEY=VALUE ...]
 
 Runs scenarios/stability-kgd.scene (a small coupled KGD fracture: 1.05 m x 2.1 m box,
 h = 0.035 m, notch 0.15 m, 1.5 s) with one input, or a few, pushed per case (the list is
@@ -257,6 +258,7 @@ def one(exe, out_root, case, a):
         if err:
             row.update(outcome="skipped", detail=err)
             return row
+    sets = list(a.set) + list(sets)
     row["sets"] = sets
     tree, err = validate(exe, scene, sets)
     if err:
@@ -331,6 +333,8 @@ def main():
     ap.add_argument("--only", nargs="+", metavar="NAME", help="run only these cases (NAME or PREFIX*)")
     ap.add_argument("--jobs", type=int, default=1, help="runs at a time (default 1; the runs are not timed)")
     ap.add_argument("--force", action="store_true", help="rerun cases that have a finished run")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene setting added to every case, before the case's own (e.g. coupling.scheme=IMPLICIT)")
     ap.add_argument("--timeout", type=float, default=3600, help="seconds per run before it is killed (default 3600)")
     a = ap.parse_args()
     if a.jobs < 1 or a.jobs > 8:
