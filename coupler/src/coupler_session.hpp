@@ -138,7 +138,7 @@ class Coupler {
   bool stopped_at_max_steps_ = false;
   // Largest fluid pressure change at frozen crack width over a report, and when (run.json).
   double max_coupling_lag_ = 0, max_coupling_lag_t_ = 0;
-  std::string dt_limit_;                              // "side: term" that set the last step
+  std::string dt_limit_;                                 // "side: term" that set the last step
   std::map<std::string, std::uint64_t> dt_limit_steps_;  // steps taken under each limit
   double dt_min_ = kInf, dt_max_ = 0;
   Log log_;

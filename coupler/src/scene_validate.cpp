@@ -22,12 +22,16 @@ void check_time_function(Checker& c, const std::string& key, const scene::TimeFu
       return;
     case scene::TimeFunction::kRamp: {
       const auto& r = f.ramp();
-      if (!r.has_t1()) c.missing(key + ".ramp.t1", "the ramp's end time t1 (s), > t0");
-      else c.range(key + ".ramp.t1", r.t1(), r.t0(), kInf, true, "s, > ramp.t0");
+      if (!r.has_t1())
+        c.missing(key + ".ramp.t1", "the ramp's end time t1 (s), > t0");
+      else
+        c.range(key + ".ramp.t1", r.t1(), r.t0(), kInf, true, "s, > ramp.t0");
       c.range(key + ".ramp.t0", r.t0(), -kInf, kInf, false, "s");
       c.range(key + ".ramp.v0", r.v0(), min_value, kInf, false, unit);
-      if (!r.has_v1()) c.missing(key + ".ramp.v1", "the ramp's end value v1 (" + unit + ")");
-      else c.range(key + ".ramp.v1", r.v1(), min_value, kInf, false, unit);
+      if (!r.has_v1())
+        c.missing(key + ".ramp.v1", "the ramp's end value v1 (" + unit + ")");
+      else
+        c.range(key + ".ramp.v1", r.v1(), min_value, kInf, false, unit);
       return;
     }
     case scene::TimeFunction::kTable: {
@@ -39,19 +43,25 @@ void check_time_function(Checker& c, const std::string& key, const scene::TimeFu
       }
       for (int i = 0; i < t.t_size(); ++i) {
         const std::string k = key + ".table.t[" + std::to_string(i) + "]";
-        if (!std::isfinite(t.t(i))) c.bad(k, text(t.t(i)), "a finite time (s)");
-        else if (i > 0 && !(t.t(i) > t.t(i - 1))) c.bad(k, text(t.t(i)), "times strictly increasing, > " + text(t.t(i - 1)));
+        if (!std::isfinite(t.t(i)))
+          c.bad(k, text(t.t(i)), "a finite time (s)");
+        else if (i > 0 && !(t.t(i) > t.t(i - 1)))
+          c.bad(k, text(t.t(i)), "times strictly increasing, > " + text(t.t(i - 1)));
         c.range(key + ".table.v[" + std::to_string(i) + "]", t.v(i), min_value, kInf, false, unit);
       }
       return;
     }
     case scene::TimeFunction::kPower: {
       const auto& p = f.power();
-      if (!p.has_scale()) c.missing(key + ".power.scale", "the scale (" + unit + ")");
-      else c.range(key + ".power.scale", p.scale(), min_value, kInf, false, unit);
+      if (!p.has_scale())
+        c.missing(key + ".power.scale", "the scale (" + unit + ")");
+      else
+        c.range(key + ".power.scale", p.scale(), min_value, kInf, false, unit);
       c.positive(key + ".power.t_ref", p.t_ref(), "s");
-      if (!p.has_exponent()) c.missing(key + ".power.exponent", "the exponent, >= 0");
-      else c.non_negative(key + ".power.exponent", p.exponent(), "");
+      if (!p.has_exponent())
+        c.missing(key + ".power.exponent", "the exponent, >= 0");
+      else
+        c.non_negative(key + ".power.exponent", p.exponent(), "");
       return;
     }
   }
@@ -110,15 +120,17 @@ void check_prescribed_crack(Checker& c, const scene::PrescribedCrack& p) {
   c.range(key + "mouth_x_m", p.mouth_x_m(), -kInf, kInf, false, "m");
   c.range(key + "mouth_y_m", p.mouth_y_m(), -kInf, kInf, false, "m");
   c.range(key + "angle_deg", p.angle_deg(), -180, 180, false, "degrees");
-  if (!p.has_initial_length_m()) c.missing(key + "initial_length_m", "the initial crack length (m), > 0");
-  else c.positive(key + "initial_length_m", p.initial_length_m(), "m");
+  if (!p.has_initial_length_m())
+    c.missing(key + "initial_length_m", "the initial crack length (m), > 0");
+  else
+    c.positive(key + "initial_length_m", p.initial_length_m(), "m");
   c.non_negative(key + "growth_speed_m_per_s", p.growth_speed_m_per_s(), "m/s");
   const double max_length = p.has_max_length_m() ? p.max_length_m() : p.initial_length_m();
   if (p.has_max_length_m()) {
-    c.range(key + "max_length_m", p.max_length_m(), p.initial_length_m(), kInf, false,
-            "m, >= initial_length_m");
+    c.range(key + "max_length_m", p.max_length_m(), p.initial_length_m(), kInf, false, "m, >= initial_length_m");
   } else if (p.growth_speed_m_per_s() > 0) {
-    c.missing(key + "max_length_m", "the length where growth stops (m), >= initial_length_m, with growth_speed_m_per_s > 0");
+    c.missing(key + "max_length_m",
+              "the length where growth stops (m), >= initial_length_m, with growth_speed_m_per_s > 0");
   }
   if (!p.has_spacing_m()) {
     c.missing(key + "spacing_m", "the crack-particle spacing (m), > 0");
@@ -128,25 +140,33 @@ void check_prescribed_crack(Checker& c, const scene::PrescribedCrack& p) {
       c.bad(key + "spacing_m", text(p.spacing_m()), "at most 1e6 crack particles up to max_length_m");
     }
   }
-  if (!p.has_mouth_opening_m()) c.missing(key + "mouth_opening_m", "the mouth opening w(t) (m), a TimeFunction");
-  else check_time_function(c, key + "mouth_opening_m", p.mouth_opening_m(), 0.0, "m");
+  if (!p.has_mouth_opening_m())
+    c.missing(key + "mouth_opening_m", "the mouth opening w(t) (m), a TimeFunction");
+  else
+    check_time_function(c, key + "mouth_opening_m", p.mouth_opening_m(), 0.0, "m");
   if (p.profile() == scene::PrescribedCrack::PROFILE_UNSPECIFIED) {
     c.bad(key + "profile", "PROFILE_UNSPECIFIED", "ELLIPTIC, UNIFORM or CHANNEL");
   }
-  if (!p.has_stable_dt_s()) c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
-  else c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
+  if (!p.has_stable_dt_s())
+    c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
+  else
+    c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
 }
 
 void check_prescribed_pressure(Checker& c, const scene::PrescribedPressure& p) {
   const std::string key = "fluid.prescribed_pressure.";
-  if (!p.has_inlet_pressure_pa()) c.missing(key + "inlet_pressure_pa", "the inlet pressure p(t) (Pa), a TimeFunction");
-  else check_time_function(c, key + "inlet_pressure_pa", p.inlet_pressure_pa(), 0.0, "Pa");
+  if (!p.has_inlet_pressure_pa())
+    c.missing(key + "inlet_pressure_pa", "the inlet pressure p(t) (Pa), a TimeFunction");
+  else
+    check_time_function(c, key + "inlet_pressure_pa", p.inlet_pressure_pa(), 0.0, "Pa");
   if (p.profile() == scene::PrescribedPressure::PROFILE_UNSPECIFIED) {
     c.bad(key + "profile", "PROFILE_UNSPECIFIED", "UNIFORM or LINEAR");
   }
   c.range(key + "front_fraction", p.front_fraction(), 0, 1, true, "fraction of the crack length");
-  if (!p.has_stable_dt_s()) c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
-  else c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
+  if (!p.has_stable_dt_s())
+    c.missing(key + "stable_dt_s", "the step this stand-in reports (s), > 0");
+  else
+    c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
 }
 
 }  // namespace
@@ -167,16 +187,17 @@ std::vector<SceneProblem> validate(const scene::Scene& s) {
   }
   if (s.has_fluid()) {
     if (s.fluid().model_case() == scene::Fluid::MODEL_NOT_SET) {
-      c.missing("fluid", "a fluid model: fluid { mpm { ... } } or fluid { prescribed_pressure { ... } }, or no fluid "
-                         "block for a dry run");
+      c.missing("fluid",
+                "a fluid model: fluid { mpm { ... } } or fluid { prescribed_pressure { ... } }, or no fluid "
+                "block for a dry run");
     } else if (s.fluid().has_prescribed_pressure()) {
       check_prescribed_pressure(c, s.fluid().prescribed_pressure());
     } else if (s.fluid().has_mpm()) {
       check_mpm_fluid(c, s);
     }
   }
-  if (s.coupling().scheme() == scene::Coupling::IMPLICIT && s.has_fluid() && s.fluid().has_mpm() &&
-      s.has_solid() && !s.solid().has_mpm()) {
+  if (s.coupling().scheme() == scene::Coupling::IMPLICIT && s.has_fluid() && s.fluid().has_mpm() && s.has_solid() &&
+      !s.solid().has_mpm()) {
     c.bad("coupling.scheme", "IMPLICIT",
           "JACOBI or GAUSS_SEIDEL with this solid: the implicit scheme needs solid.mpm (the prescribed crack "
           "reports no face response for the fluid's interface solve)");

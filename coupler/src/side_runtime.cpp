@@ -4,15 +4,15 @@
 #include <unistd.h>
 
 #include <atomic>
-#include <condition_variable>
-#include <mutex>
-#include <optional>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <mutex>
+#include <optional>
 #include <thread>
 
 #include "exchange_log.hpp"
@@ -114,8 +114,8 @@ class SideRuntime {
     hello->set_pid(getpid());
     send(control_, hello_envelope);
     // From now on the coupler hears from this side even during a long setup.
-    heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role,
-                                                   heartbeat_step_, waiting_for_peer_);
+    heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role, heartbeat_step_,
+                                                   waiting_for_peer_);
 
     const auto deadline = Clock::now() + to_us(options_.welcome_timeout_s);
     while (true) {
@@ -171,8 +171,10 @@ class SideRuntime {
     last_from_coupler_ = Clock::now();
 
     const auto mode = welcome_.data_plane().mode();
-    if (mode != protocol::DataPlane::NONE && mode != protocol::DataPlane::BIND && mode != protocol::DataPlane::CONNECT) {
-      throw proto::ProtocolError("Welcome.data_plane.mode = " + std::to_string(mode) + "; allowed: NONE, BIND, CONNECT");
+    if (mode != protocol::DataPlane::NONE && mode != protocol::DataPlane::BIND &&
+        mode != protocol::DataPlane::CONNECT) {
+      throw proto::ProtocolError("Welcome.data_plane.mode = " + std::to_string(mode) +
+                                 "; allowed: NONE, BIND, CONNECT");
     }
     if (mode == protocol::DataPlane::BIND && options_.role != protocol::SOLID) {
       throw proto::ProtocolError("Welcome asks a " + role_ + " side to bind the data plane; only the solid binds");
@@ -254,8 +256,8 @@ class SideRuntime {
                                  std::to_string(exchange_interval_));
     }
     if (std::abs(command.t() - t_) > 1e-9 * std::max(1.0, std::abs(t_))) {
-      throw proto::ProtocolError("StepCommand t = " + std::to_string(command.t()) + " s but this side is at t = " +
-                                 std::to_string(t_) + " s");
+      throw proto::ProtocolError("StepCommand t = " + std::to_string(command.t()) +
+                                 " s but this side is at t = " + std::to_string(t_) + " s");
     }
   }
 
@@ -392,7 +394,9 @@ class SideRuntime {
     const bool right_payload = options_.role == protocol::SOLID ? frame.has_fluid() : frame.has_crack();
     if (!right_payload) {
       throw proto::ProtocolError("DataFrame from " + from + " carries " +
-                                 (frame.has_crack() ? "a CrackState" : frame.has_fluid() ? "a FluidState" : "nothing") +
+                                 (frame.has_crack()   ? "a CrackState"
+                                  : frame.has_fluid() ? "a FluidState"
+                                                      : "nothing") +
                                  "; a " + peer_ + " side sends " +
                                  (options_.role == protocol::SOLID ? "FluidState" : "CrackState"));
     }
@@ -454,7 +458,8 @@ class SideRuntime {
   microseconds spin_{0};
   std::uint32_t exchange_interval_ = 1;
   bool waits_first_ = false;
-  double publish_compute_s_ = 0;  // s in model_.publish since the last StepReport  // this side consumes the peer's frame of a step before stepping
+  double publish_compute_s_ = 0;  // s in model_.publish since the last StepReport  // this side consumes the peer's
+                                  // frame of a step before stepping
   bool has_peer_ = false;
   bool poison_next_frame_ = false;
   bool set_up_ = false;

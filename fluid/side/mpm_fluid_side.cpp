@@ -121,7 +121,8 @@ class MpmFluidSide final : public coupling::SideModel {
       d.fluid_volume += s.fluid_volume();
       d.front_position = std::max(d.front_position, s.front_position());
       d.fluid_particles += static_cast<std::uint32_t>(s.particles().size());
-      d.coupling_lag = std::max(d.coupling_lag, config_.implicit_interface ? s.interface_mismatch() : s.frozen_width_rise());
+      d.coupling_lag =
+          std::max(d.coupling_lag, config_.implicit_interface ? s.interface_mismatch() : s.frozen_width_rise());
     }
     return d;
   }

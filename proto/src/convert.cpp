@@ -98,8 +98,8 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
   check_finite(type, id, "ny", crack.ny());
   check_finite(type, id, "width", crack.width());
   check_unique_ids(type, id, crack.ids());
-  const bool response = crack.opening_rate_size() > 0 || crack.opening_acceleration_size() > 0 ||
-                        crack.opening_compliance_size() > 0;
+  const bool response =
+      crack.opening_rate_size() > 0 || crack.opening_acceleration_size() > 0 || crack.opening_compliance_size() > 0;
   if (!response && (crack.plane_rate_x_size() > 0 || crack.plane_rate_y_size() > 0 ||
                     crack.plane_acceleration_x_size() > 0 || crack.plane_acceleration_y_size() > 0)) {
     fail(type, id, "plane_rate / plane_acceleration come only with the opening_* response arrays");

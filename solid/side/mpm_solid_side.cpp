@@ -184,7 +184,7 @@ class MpmSolidSide final : public coupling::SideModel {
 
   std::optional<mpm::Solver> solver_;
   std::vector<std::optional<TimeFunction>> prescribed_;
-  bool implicit_ = false;                // coupling.scheme IMPLICIT: publish the faces' response
+  bool implicit_ = false;               // coupling.scheme IMPLICIT: publish the faces' response
   std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)
   std::optional<output::FrameWriter> writer_;
 };

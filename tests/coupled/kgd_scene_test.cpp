@@ -32,8 +32,12 @@ struct KgdHistory {
 };
 KgdHistory read_kgd_history(const std::string& out) {
   const Csv h = read_csv(out + "/history.csv");
-  KgdHistory k{h.values("time_s"),           h.values("crack_length_m"),     h.values("mouth_opening_m"),
-               h.values("inlet_pressure_pa"), h.values("injected_volume_m2"), h.values("fluid_volume_m2"),
+  KgdHistory k{h.values("time_s"),
+               h.values("crack_length_m"),
+               h.values("mouth_opening_m"),
+               h.values("inlet_pressure_pa"),
+               h.values("injected_volume_m2"),
+               h.values("fluid_volume_m2"),
                h.values("kinetic_energy_j")};
   const auto dt = h.values("dt_s");
   k.dt_max = dt.empty() ? 0.0 : *std::max_element(dt.begin(), dt.end());
@@ -60,7 +64,7 @@ TEST(KgdScene, ToughnessSceneRunsStablyConservesFluidAndGrows) {
   const auto [t, length, mouth, p_in, injected, volume, ke, dt_max] = read_kgd_history(out);
   ASSERT_GE(t.size(), 10u);
   constexpr double kQ = 4.15e-4, kRamp = 0.05, kSigma0 = 1e5, kK = 2e6, kC = 0.0894;
-  constexpr double kInitial = 0.2 * 2e-5;     // the notch's fluid at 1e5 Pa: the virtual film x 0.2 m
+  constexpr double kInitial = 0.2 * 2e-5;  // the notch's fluid at 1e5 Pa: the virtual film x 0.2 m
   double work = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
     for (double v : {length[i], mouth[i], p_in[i], injected[i], volume[i], ke[i]}) ASSERT_TRUE(std::isfinite(v));
@@ -72,9 +76,10 @@ TEST(KgdScene, ToughnessSceneRunsStablyConservesFluidAndGrows) {
     const double zero_pressure_volume = injected[i] + kInitial / (1 - kC * std::log1p(kSigma0 / (kC * kK)));
     EXPECT_NEAR(volume[i] / zero_pressure_volume, 1, 0.1) << "t = " << t[i];
   }
-  std::printf("kgd-toughness to %.2f s: length %.3f m, mouth opening %.3e m, inlet pressure %.0f Pa, "
-              "max kinetic energy / inlet work %.2e\n",
-              t.back(), length.back(), mouth.back(), p_in.back(), *std::max_element(ke.begin(), ke.end()) / work);
+  std::printf(
+      "kgd-toughness to %.2f s: length %.3f m, mouth opening %.3e m, inlet pressure %.0f Pa, "
+      "max kinetic energy / inlet work %.2e\n",
+      t.back(), length.back(), mouth.back(), p_in.back(), *std::max_element(ke.begin(), ke.end()) / work);
   EXPECT_GT(p_in.back(), kSigma0);
   EXPECT_GT(mouth.back(), 5e-4);
   EXPECT_GE(length.back(), 0.2 + 0.01);  // at least one growth step of a quarter cell (0.0125 m; measured 0.212 m)
@@ -199,11 +204,10 @@ TEST(KgdScene, ToughnessCiSceneFollowsTheKVertex) {
 // most one increment plus 2%. Against the M-vertex, water's opening is
 // within 10% and its net pressure within 20% (the CI bounds). Measured: at
 // equal tips 1.35% (opening) and 1.71% (pressure) worst, at unequal tips
-// 1.83% and 2.04%; fronts 1.6%; water against the M-vertex 1.2% and 3.6%. (The tip's half-length runs 7-16% long, its fluid front
-// 3-8%, at h = 0.035 m; 6-9% and 4-6% at h = 0.025 m: a spatial error and
-// the notch's memory, docs/verification.md; not asserted here.) K = 2e6 Pa
-// is left out on purpose: at 1.1e5 Pa it is compressed by 5%, a physical
-// difference (its opening is 2.3% smaller).
+// 1.83% and 2.04%; fronts 1.6%; water against the M-vertex 1.2% and 3.6%. (The tip's half-length runs 7-16% long, its
+// fluid front 3-8%, at h = 0.035 m; 6-9% and 4-6% at h = 0.025 m: a spatial error and the notch's memory,
+// docs/verification.md; not asserted here.) K = 2e6 Pa is left out on purpose: at 1.1e5 Pa it is compressed by 5%, a
+// physical difference (its opening is 2.3% smaller).
 TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
   struct Run {
     std::vector<double> t, length, front, mouth, p_in;

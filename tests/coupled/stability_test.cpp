@@ -45,8 +45,9 @@ double ramp_volume(double t) { return t >= kRamp ? kQ * (t - 0.5 * kRamp) : 0.5 
 
 void expect_sane(const Case& c) {
   const auto out = scratch_dir(std::string("stability_") + c.name);
-  std::vector<std::string> argv = {bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out,
-                                   "--quiet", "--set", "output.hdf5=false"};
+  std::vector<std::string> argv = {
+      bin("hfmpm"),       "run", source("scenarios/stability-kgd.scene"), "--out", out, "--quiet", "--set",
+      "output.hdf5=false"};
   for (const auto& s : c.sets) {
     argv.push_back("--set");
     argv.push_back(s);
@@ -74,9 +75,10 @@ void expect_sane(const Case& c) {
       ke_ratio = std::max(ke_ratio, ke[i] / work);
     }
   }
-  std::printf("%s: %zu rows to t = %.2f s, inlet pressure %.0f Pa, fluid volume / zero-pressure volume %.3f, "
-              "max kinetic energy / inlet work %.1e\n",
-              c.name, t.size(), t.back(), p_in.back(), volume.back() / (injected.back() + c.initial_volume), ke_ratio);
+  std::printf(
+      "%s: %zu rows to t = %.2f s, inlet pressure %.0f Pa, fluid volume / zero-pressure volume %.3f, "
+      "max kinetic energy / inlet work %.1e\n",
+      c.name, t.size(), t.back(), p_in.back(), volume.back() / (injected.back() + c.initial_volume), ke_ratio);
 }
 
 constexpr double kFilm = 2e-5 * 0.15;  // the scene's virtual opening x notch
@@ -87,10 +89,11 @@ TEST(Stability, ThinFluid) { expect_sane({"mu_1e-4", {"fluid.mpm.viscosity_pa_s=
 TEST(Stability, ThickFluid) { expect_sane({"mu_1", {"fluid.mpm.viscosity_pa_s=1"}, kFilm}); }
 TEST(Stability, LargePreOpening) { expect_sane({"film_1mm", {"fluid.mpm.virtual_opening_m=1e-3"}, 1e-3 * 0.15}); }
 TEST(Stability, NoConfinement) {
-  expect_sane({"unconfined",
-               {"solid.mpm.regions=[{material: \"rock\" rectangle { x_min_m: 0 y_min_m: -1.05 x_max_m: 1.05 y_max_m: 1.05 }}]",
-                "solid.mpm.tractions=[]", "fluid.mpm.initial_fill.pressure_pa=0", "fluid.mpm.lag_pressure_pa=0"},
-               kFilm});
+  expect_sane(
+      {"unconfined",
+       {"solid.mpm.regions=[{material: \"rock\" rectangle { x_min_m: 0 y_min_m: -1.05 x_max_m: 1.05 y_max_m: 1.05 }}]",
+        "solid.mpm.tractions=[]", "fluid.mpm.initial_fill.pressure_pa=0", "fluid.mpm.lag_pressure_pa=0"},
+       kFilm});
 }
 TEST(Stability, TenTimesTheEndTime) { expect_sane({"long", {"time.end_s=15"}, kFilm}); }
 // Water (K = 2 GPa) blows up at the scene's step (below) but not at a sixth of
@@ -117,9 +120,18 @@ TEST(Stability, StiffFluidAtTheScenesStepWithTheImplicitScheme) {
 TEST(Stability, TheStepIsChosenFromTheSidesAndNamed) {
   auto run_with = [](const std::string& name, const std::vector<std::string>& sets) {
     const auto out = scratch_dir("stability_dt_" + name);
-    std::vector<std::string> argv = {bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out,
-                                     "--quiet", "--set", "output.hdf5=false", "--set", "time.end_s=0.005",
-                                     "--set", "output.interval_s=0.0025"};
+    std::vector<std::string> argv = {bin("hfmpm"),
+                                     "run",
+                                     source("scenarios/stability-kgd.scene"),
+                                     "--out",
+                                     out,
+                                     "--quiet",
+                                     "--set",
+                                     "output.hdf5=false",
+                                     "--set",
+                                     "time.end_s=0.005",
+                                     "--set",
+                                     "output.interval_s=0.0025"};
     for (const auto& s : sets) {
       argv.push_back("--set");
       argv.push_back(s);
@@ -148,9 +160,8 @@ TEST(Stability, TheStepIsChosenFromTheSidesAndNamed) {
 // keep the output.
 void expect_runaway_diagnosed(const char* name, const std::string& set, const std::vector<const char*>& parts) {
   const auto out = scratch_dir(std::string("stability_") + name);
-  const auto result = run({bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out, "--quiet",
-                           "--set", set},
-                          300);
+  const auto result =
+      run({bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out, "--quiet", "--set", set}, 300);
   EXPECT_NE(result.exit_code, 0);
   for (const char* part : parts) {
     EXPECT_NE(result.err.find(part), std::string::npos) << part << " not in: " << result.err;
@@ -164,8 +175,9 @@ void expect_runaway_diagnosed(const char* name, const std::string& set, const st
   EXPECT_LT(std::stoi(result.err.substr(steps + 8)), 100) << "detected late";
 }
 
-const std::vector<const char*> kRunawayParts = {"ran away at step", "particle", "cells in one step",
-                                                "Largest crack face pressure", "virtual_opening_m", "solid.mpm.cfl"};
+const std::vector<const char*> kRunawayParts = {"ran away at step",  "particle",
+                                                "cells in one step", "Largest crack face pressure",
+                                                "virtual_opening_m", "solid.mpm.cfl"};
 
 TEST(Stability, PressureSpikeStopsTheRunWithADiagnosis) {
   expect_runaway_diagnosed("spike", "fluid.mpm.virtual_opening_m=1e-8", kRunawayParts);
@@ -188,13 +200,23 @@ TEST(Stability, WaterStiffFluidStopsTheRunWithADiagnosis) {
 // kinetic energy against the inlet's work plus p0 V0) stops it within a few
 // control rounds (measured: step 60, 26x the bound) and says what to change.
 TEST(Stability, EnergyCreatedByTheExchangeStopsTheRunWithADiagnosis) {
+  // kgd-viscosity at h = 0.05 m, exchanging every 4th step.
+  const std::vector<std::string> settings = {"coupling.exchange_interval=4",  "solid.mpm.cell_size_m=0.05",
+                                             "solid.mpm.grid.y_min_m=-5.225", "solid.mpm.grid.y_max_m=5.225",
+                                             "solid.mpm.grid.x_max_m=5.15",   "solid.mpm.cfl=0.4"};
+  auto command = [&](const std::string& out, const std::vector<std::string>& more) {
+    std::vector<std::string> argv = {bin("hfmpm"), "run", source("scenarios/kgd-viscosity.scene"),
+                                     "--out",      out,   "--quiet"};
+    for (const auto* list : {&settings, &more}) {
+      for (const auto& s : *list) {
+        argv.push_back("--set");
+        argv.push_back(s);
+      }
+    }
+    return argv;
+  };
   const auto out = scratch_dir("stability_exchange_4");
-  const auto result =
-      run({bin("hfmpm"), "run", source("scenarios/kgd-viscosity.scene"), "--out", out, "--quiet", "--set",
-           "coupling.exchange_interval=4", "--set", "solid.mpm.cell_size_m=0.05", "--set",
-           "solid.mpm.grid.y_min_m=-5.225", "--set", "solid.mpm.grid.y_max_m=5.225", "--set",
-           "solid.mpm.grid.x_max_m=5.15", "--set", "solid.mpm.cfl=0.4", "--set", "time.end_s=0.5"},
-          300);
+  const auto result = run(command(out, {"time.end_s=0.5"}), 300);
   EXPECT_NE(result.exit_code, 0);
   for (const char* part : {"energy is being created", "kinetic energy", "inlet work", "coupling.energy_bound",
                            "coupling.exchange_interval: 1"}) {
@@ -209,13 +231,9 @@ TEST(Stability, EnergyCreatedByTheExchangeStopsTheRunWithADiagnosis) {
   EXPECT_LT(std::stoi(result.err.substr(at + 8)), 200) << "detected late";
   // The same settings with the check off run on: the check is what stops it.
   const auto unchecked = scratch_dir("stability_exchange_4_unchecked");
-  const auto off = run({bin("hfmpm"), "run", source("scenarios/kgd-viscosity.scene"), "--out", unchecked, "--quiet",
-                        "--set", "output.hdf5=false", "--set", "coupling.exchange_interval=4", "--set",
-                        "solid.mpm.cell_size_m=0.05", "--set", "solid.mpm.grid.y_min_m=-5.225", "--set",
-                        "solid.mpm.grid.y_max_m=5.225", "--set", "solid.mpm.grid.x_max_m=5.15", "--set",
-                        "solid.mpm.cfl=0.4", "--set", "time.end_s=0.1", "--set", "output.interval_s=0.05", "--set",
-                        "coupling.energy_bound=0"},
-                       300);
+  const auto off = run(
+      command(unchecked, {"output.hdf5=false", "time.end_s=0.1", "output.interval_s=0.05", "coupling.energy_bound=0"}),
+      300);
   EXPECT_EQ(off.exit_code, 0) << off.err;
 }
 

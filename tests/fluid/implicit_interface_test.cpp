@@ -104,9 +104,10 @@ Result run(double bulk_modulus, double dt, int steps) {
 TEST(ImplicitInterface, WallsCarryThePressureTheFluidHasAtTheEndOfTheStep) {
   for (double K : {2e6, 2e9}) {
     const Result r = run(K, 1e-3, 200);
-    std::printf("K = %g Pa: worst mismatch %.3e Pa (net pressure %.3e Pa), volume gain %.6e m^2 against %.6e "
-                "injected, mass error %.1e, step / acoustic step %.0f\n",
-                K, r.worst_mismatch, r.net, r.volume_gain, r.injected, r.mass_error, 1e-3 / r.acoustic_dt);
+    std::printf(
+        "K = %g Pa: worst mismatch %.3e Pa (net pressure %.3e Pa), volume gain %.6e m^2 against %.6e "
+        "injected, mass error %.1e, step / acoustic step %.0f\n",
+        K, r.worst_mismatch, r.net, r.volume_gain, r.injected, r.mass_error, 1e-3 / r.acoustic_dt);
     EXPECT_LT(r.worst_mismatch, 2e-3 * r.net) << K;
     EXPECT_LT(r.mass_error, 1e-12) << K;
     // The walls open by the injected volume less what the fluid compressed (p / K).

@@ -243,147 +243,147 @@ void FluidSolver::step_implicit(double dt) {
     // before the step, and the step is solved again.
     for (int attempt = 0;; ++attempt) {
       try {
-      if (config_.outlet.enabled && particles_.end(particles_.size() - 1) >= grid_.length()) outlet_wetted_ = true;
-      update_state();
-      p2g();  // mass, momentum and friction of the nodes; the force is the trial's
-      const auto& arc = grid_.arc();
-      const std::size_t np = particles_.size();
-      pieces_.assign(np, {});
-      std::vector<double> P(elements, 0.0), weight(elements, 0.0);
-      for (std::size_t p = 0; p < np; ++p) {
-        for_pieces(arc, particles_.start(p), particles_.end(p), [&](std::size_t e, double f) {
-          pieces_[p].push_back({e, f});
-          P[e] += f * particles_.mass[p] * particles_.pressure[p];
-          weight[e] += f * particles_.mass[p];
-        });
-      }
-      for (std::size_t e = 0; e < elements; ++e) P[e] = weight[e] > 0 ? P[e] / weight[e] : 0.0;
-      // Start from the last step's solution where there was fluid (the state's
-      // pressure differs from it by the mismatch of the solid's response).
-      for (std::size_t e = 0; e < std::min(elements, solved_.size()); ++e)
-        if (weight[e] > 0 && solved_[e] > 0) P[e] = solved_[e];
-      // The complementarity problem: P_e >= 0, g_e >= 0, P_e g_e = 0 (the
-      // fluid fills its element at its pressure, or cavitates at P = 0), in
-      // the min form Phi_e = min(P_e / K, g_e) = 0, by semismooth Newton:
-      // each iteration takes the rows of the active branch (P_e = 0 where
-      // P_e / K <= g_e, else the volume balance g_e = 0) with a fresh
-      // finite-difference Jacobian of g, and a backtracking line search on
-      // |Phi|. Stiff fluids live at the kink (J ~ 1), so the branch must be
-      // chosen per iteration, not fixed by a chord Jacobian.
+        if (config_.outlet.enabled && particles_.end(particles_.size() - 1) >= grid_.length()) outlet_wetted_ = true;
+        update_state();
+        p2g();  // mass, momentum and friction of the nodes; the force is the trial's
+        const auto& arc = grid_.arc();
+        const std::size_t np = particles_.size();
+        pieces_.assign(np, {});
+        std::vector<double> P(elements, 0.0), weight(elements, 0.0);
+        for (std::size_t p = 0; p < np; ++p) {
+          for_pieces(arc, particles_.start(p), particles_.end(p), [&](std::size_t e, double f) {
+            pieces_[p].push_back({e, f});
+            P[e] += f * particles_.mass[p] * particles_.pressure[p];
+            weight[e] += f * particles_.mass[p];
+          });
+        }
+        for (std::size_t e = 0; e < elements; ++e) P[e] = weight[e] > 0 ? P[e] / weight[e] : 0.0;
+        // Start from the last step's solution where there was fluid (the state's
+        // pressure differs from it by the mismatch of the solid's response).
+        for (std::size_t e = 0; e < std::min(elements, solved_.size()); ++e)
+          if (weight[e] > 0 && solved_[e] > 0) P[e] = solved_[e];
+        // The complementarity problem: P_e >= 0, g_e >= 0, P_e g_e = 0 (the
+        // fluid fills its element at its pressure, or cavitates at P = 0), in
+        // the min form Phi_e = min(P_e / K, g_e) = 0, by semismooth Newton:
+        // each iteration takes the rows of the active branch (P_e = 0 where
+        // P_e / K <= g_e, else the volume balance g_e = 0) with a fresh
+        // finite-difference Jacobian of g, and a backtracking line search on
+        // |Phi|. Stiff fluids live at the kink (J ~ 1), so the branch must be
+        // chosen per iteration, not fixed by a chord Jacobian.
         std::vector<double> g, g_probe, phi(elements), candidate(elements), phi_candidate(elements);
-      auto fail = [&](const char* what) {
-        if (trial.squeezed >= 0 && particles_.size() > 1 && attempt < 16) throw Squeezed{trial.squeezed};
-        std::ostringstream out;
-        out << "fluid: crack " << grid_.crack_id() << ": the implicit interface step of " << dt << " s " << what
-            << " (stable dt " << stable_dt() << " s); the step is too large";
-        throw std::runtime_error(out.str());
-      };
-      if (!interface_trial(P, dt, trial, g)) {
-        std::fill(P.begin(), P.end(), 0.0);  // no pressure moves no particle end far
-        if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out at zero pressure");
-      }
-      const double K = config_.bulk_modulus;
-      auto min_form = [&](const std::vector<double>& p, const std::vector<double>& gg, std::vector<double>& out) {
-        double sum = 0;
-        for (std::size_t e = 0; e < elements; ++e) {
-          out[e] = std::min(p[e] / K, gg[e]);
-          sum += out[e] * out[e];
+        auto fail = [&](const char* what) {
+          if (trial.squeezed >= 0 && particles_.size() > 1 && attempt < 16) throw Squeezed{trial.squeezed};
+          std::ostringstream out;
+          out << "fluid: crack " << grid_.crack_id() << ": the implicit interface step of " << dt << " s " << what
+              << " (stable dt " << stable_dt() << " s); the step is too large";
+          throw std::runtime_error(out.str());
+        };
+        if (!interface_trial(P, dt, trial, g)) {
+          std::fill(P.begin(), P.end(), 0.0);  // no pressure moves no particle end far
+          if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out at zero pressure");
         }
-        return std::sqrt(sum);
-      };
-      // Tolerance: a volume strain of 1e-11 (K x 1e-11 in pressure: 0.02 Pa for water).
-      const double tolerance = 1e-11;
-      const double scale = std::max({max_abs(P), config_.lag_pressure, 1e-6 * K, 1.0});
-      const double delta = 1e-6 * scale;
-      Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(elements), static_cast<Eigen::Index>(elements));
-      Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-      std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
-      double norm = min_form(P, g, phi);
-      // The best iterate so far is the answer.
-      std::vector<double> best_P = P, best_g = g, best_phi = phi;
-      double best_norm = norm;
-      for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
-        ++interface_iterations_;
-        for (auto& row : dg) row.clear();
-        std::vector<double> probe;
-        for (std::size_t colour = 0; colour < kColours && colour < elements; ++colour) {
-          // A forward difference, or a backward one where the forward probe
-          // squeezes a particle to nothing (P lies at the edge of the feasible set).
-          double step = delta;
-          probe = P;
-          for (std::size_t e = colour; e < elements; e += kColours) probe[e] += step;
-          if (!interface_trial(probe, dt, trial, g_probe)) {
-            step = -delta;
-            for (std::size_t e = colour; e < elements; e += kColours) probe[e] = std::max(0.0, P[e] + step);
-            if (!interface_trial(probe, dt, trial, g_probe)) fail("turns a particle inside out while probing");
+        const double K = config_.bulk_modulus;
+        auto min_form = [&](const std::vector<double>& p, const std::vector<double>& gg, std::vector<double>& out) {
+          double sum = 0;
+          for (std::size_t e = 0; e < elements; ++e) {
+            out[e] = std::min(p[e] / K, gg[e]);
+            sum += out[e] * out[e];
           }
-          for (std::size_t row = 0; row < elements; ++row) {
-            const std::size_t r0 = (row % kColours + kColours - colour) % kColours;
-            const std::size_t c0 = r0 <= kReach ? row - r0 : row + (kColours - r0);
-            const double moved = c0 < elements ? probe[c0] - P[c0] : 0.0;
-            if (moved == 0) continue;
-            const double d = (g_probe[row] - g[row]) / moved;
-            if (d == 0) continue;
-            // The perturbed element of this colour nearest the row (one lies within kReach).
-            const std::size_t r = (row % kColours + kColours - colour) % kColours;
-            const std::size_t col = r <= kReach ? row - r : row + (kColours - r);
-            if (col < elements) dg[row].push_back({col, d});
-          }
-        }
-        std::vector<Eigen::Triplet<double>> entries;
-        for (std::size_t e = 0; e < elements; ++e) {
-          const auto row = static_cast<Eigen::Index>(e);
-          if (P[e] / K <= g[e]) {
-            entries.emplace_back(row, row, 1.0 / K);
-          } else {
-            bool diagonal = false;
-            for (const auto& [col, d] : dg[e]) {
-              entries.emplace_back(row, static_cast<Eigen::Index>(col), d);
-              diagonal = diagonal || col == e;
+          return std::sqrt(sum);
+        };
+        // Tolerance: a volume strain of 1e-11 (K x 1e-11 in pressure: 0.02 Pa for water).
+        const double tolerance = 1e-11;
+        const double scale = std::max({max_abs(P), config_.lag_pressure, 1e-6 * K, 1.0});
+        const double delta = 1e-6 * scale;
+        Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(elements), static_cast<Eigen::Index>(elements));
+        Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+        std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
+        double norm = min_form(P, g, phi);
+        // The best iterate so far is the answer.
+        std::vector<double> best_P = P, best_g = g, best_phi = phi;
+        double best_norm = norm;
+        for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
+          ++interface_iterations_;
+          for (auto& row : dg) row.clear();
+          std::vector<double> probe;
+          for (std::size_t colour = 0; colour < kColours && colour < elements; ++colour) {
+            // A forward difference, or a backward one where the forward probe
+            // squeezes a particle to nothing (P lies at the edge of the feasible set).
+            double step = delta;
+            probe = P;
+            for (std::size_t e = colour; e < elements; e += kColours) probe[e] += step;
+            if (!interface_trial(probe, dt, trial, g_probe)) {
+              step = -delta;
+              for (std::size_t e = colour; e < elements; e += kColours) probe[e] = std::max(0.0, P[e] + step);
+              if (!interface_trial(probe, dt, trial, g_probe)) fail("turns a particle inside out while probing");
             }
-            // A probe that could not move P_e (held at 0) leaves out the
-            // fluid's own compliance, -dJ/dP = 1 / (K + P / c): put it in.
-            if (!diagonal) entries.emplace_back(row, row, 1.0 / (K + P[e] / config_.tait_c));
+            for (std::size_t row = 0; row < elements; ++row) {
+              const std::size_t r0 = (row % kColours + kColours - colour) % kColours;
+              const std::size_t c0 = r0 <= kReach ? row - r0 : row + (kColours - r0);
+              const double moved = c0 < elements ? probe[c0] - P[c0] : 0.0;
+              if (moved == 0) continue;
+              const double d = (g_probe[row] - g[row]) / moved;
+              if (d == 0) continue;
+              // The perturbed element of this colour nearest the row (one lies within kReach).
+              const std::size_t r = (row % kColours + kColours - colour) % kColours;
+              const std::size_t col = r <= kReach ? row - r : row + (kColours - r);
+              if (col < elements) dg[row].push_back({col, d});
+            }
           }
-        }
-        system.setFromTriplets(entries.begin(), entries.end());
-        lu.compute(system);
-        if (lu.info() != Eigen::Success) fail("gave a singular interface Jacobian");
-        Eigen::VectorXd rhs(static_cast<Eigen::Index>(elements));
-        for (std::size_t e = 0; e < elements; ++e) rhs[static_cast<Eigen::Index>(e)] = -phi[e];
-        const Eigen::VectorXd d = lu.solve(rhs);
-        double lambda = 1;
-        bool accepted = false;
-        for (int halving = 0; halving < 30; ++halving, lambda *= 0.5) {
-          for (std::size_t e = 0; e < elements; ++e)
-            candidate[e] = std::max(0.0, P[e] + lambda * d[static_cast<Eigen::Index>(e)]);
-          if (!interface_trial(candidate, dt, trial, g_probe)) continue;
-          const double candidate_norm = min_form(candidate, g_probe, phi_candidate);
-          if (candidate_norm < (1 - 1e-4 * lambda) * norm) {
-            P.swap(candidate);
-            g.swap(g_probe);
-            phi.swap(phi_candidate);
-            norm = candidate_norm;
-            accepted = true;
-            break;
+          std::vector<Eigen::Triplet<double>> entries;
+          for (std::size_t e = 0; e < elements; ++e) {
+            const auto row = static_cast<Eigen::Index>(e);
+            if (P[e] / K <= g[e]) {
+              entries.emplace_back(row, row, 1.0 / K);
+            } else {
+              bool diagonal = false;
+              for (const auto& [col, d] : dg[e]) {
+                entries.emplace_back(row, static_cast<Eigen::Index>(col), d);
+                diagonal = diagonal || col == e;
+              }
+              // A probe that could not move P_e (held at 0) leaves out the
+              // fluid's own compliance, -dJ/dP = 1 / (K + P / c): put it in.
+              if (!diagonal) entries.emplace_back(row, row, 1.0 / (K + P[e] / config_.tait_c));
+            }
           }
+          system.setFromTriplets(entries.begin(), entries.end());
+          lu.compute(system);
+          if (lu.info() != Eigen::Success) fail("gave a singular interface Jacobian");
+          Eigen::VectorXd rhs(static_cast<Eigen::Index>(elements));
+          for (std::size_t e = 0; e < elements; ++e) rhs[static_cast<Eigen::Index>(e)] = -phi[e];
+          const Eigen::VectorXd d = lu.solve(rhs);
+          double lambda = 1;
+          bool accepted = false;
+          for (int halving = 0; halving < 30; ++halving, lambda *= 0.5) {
+            for (std::size_t e = 0; e < elements; ++e)
+              candidate[e] = std::max(0.0, P[e] + lambda * d[static_cast<Eigen::Index>(e)]);
+            if (!interface_trial(candidate, dt, trial, g_probe)) continue;
+            const double candidate_norm = min_form(candidate, g_probe, phi_candidate);
+            if (candidate_norm < (1 - 1e-4 * lambda) * norm) {
+              P.swap(candidate);
+              g.swap(g_probe);
+              phi.swap(phi_candidate);
+              norm = candidate_norm;
+              accepted = true;
+              break;
+            }
+          }
+          if (norm < best_norm) {
+            best_P = P;
+            best_g = g;
+            best_phi = phi;
+            best_norm = norm;
+          }
+          if (!accepted) break;
         }
-        if (norm < best_norm) {
-          best_P = P;
-          best_g = g;
-          best_phi = phi;
-          best_norm = norm;
-        }
-        if (!accepted) break;
-      }
-      P.swap(best_P);
-      g.swap(best_g);
-      phi.swap(best_phi);
-      interface_residual_ = max_abs(phi) * K;  // Pa
-      interface_newton_ += static_cast<std::uint64_t>(interface_iterations_);
-      if (max_abs(phi) > tolerance) ++interface_unconverged_;
-      if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out");
-      solved_ = P;
+        P.swap(best_P);
+        g.swap(best_g);
+        phi.swap(best_phi);
+        interface_residual_ = max_abs(phi) * K;  // Pa
+        interface_newton_ += static_cast<std::uint64_t>(interface_iterations_);
+        if (max_abs(phi) > tolerance) ++interface_unconverged_;
+        if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out");
+        solved_ = P;
         // Commit: the explicit update of step() under the solved pressures.
         for (std::size_t p = 0; p < np; ++p) particles_.pressure[p] = trial.pp[p];
         faces = trial.nodal;

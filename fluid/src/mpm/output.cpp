@@ -43,9 +43,7 @@ void FluidSolver::fill(double front, double pressure) {
   pressure_at_set_ = nodal_pressure_;  // the fill is the start, not a change
 }
 
-void FluidSolver::project_pressure() {
-  project_pressure(particles_.pressure, nodal_pressure_, mass_);
-}
+void FluidSolver::project_pressure() { project_pressure(particles_.pressure, nodal_pressure_, mass_); }
 
 void FluidSolver::project_pressure(const std::vector<double>& pp, std::vector<double>& nodal,
                                    std::vector<double>& scratch) const {

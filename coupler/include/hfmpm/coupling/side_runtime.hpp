@@ -32,7 +32,7 @@ class SideModel {
   virtual double stable_dt() const = 0;  // s; +inf if unlimited
   // What sets stable_dt() now, in a few words (run.json names the term that limited the step).
   virtual std::string stable_dt_limit() const { return {}; }
-  virtual void advance(double dt) = 0;   // one explicit step
+  virtual void advance(double dt) = 0;  // one explicit step
   // Fill the payload of the frame this side sends (crack for a solid, fluid for a fluid).
   virtual void publish(protocol::DataFrame& frame) = 0;
   // Apply a frame from the peer; throws proto::ProtocolError if it is inconsistent.
@@ -52,14 +52,14 @@ struct Fault {
 
 struct SideOptions {
   protocol::Role role = protocol::ROLE_UNSPECIFIED;
-  std::string control_endpoint;          // the coupler's control socket
-  std::string implementation;            // e.g. "hfmpm-prescribed-solid"
+  std::string control_endpoint;  // the coupler's control socket
+  std::string implementation;    // e.g. "hfmpm-prescribed-solid"
   std::string implementation_version = "0.1.0";
   std::vector<std::string> capabilities;
-  std::string advertise_host;            // tcp: host the peer can reach this side at
-  std::string output_dir;                // overrides the coupler's output_dir
-  double welcome_timeout_s = 60;         // the coupler must answer Hello within this
-  zmq::context_t* context = nullptr;     // shared context (in-process mode); own one if null
+  std::string advertise_host;                                // tcp: host the peer can reach this side at
+  std::string output_dir;                                    // overrides the coupler's output_dir
+  double welcome_timeout_s = 60;                             // the coupler must answer Hello within this
+  zmq::context_t* context = nullptr;                         // shared context (in-process mode); own one if null
   std::uint32_t protocol_version = proto::kProtocolVersion;  // tests claim others
   Fault fault;
 };

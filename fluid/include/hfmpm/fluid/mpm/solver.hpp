@@ -215,13 +215,13 @@ class FluidSolver {
   std::vector<double> wall_rate_, wall_acceleration_, wall_compliance_;  // from the solid (CrackGeometry)
   std::size_t wall_band_ = 0;
   std::vector<Vec2> wall_plane_rate_, wall_plane_acceleration_;  // the crack plane's motion (may be empty)
-  std::vector<double> predicted_arc_;                             // node arc lengths at the end of the step
+  std::vector<double> predicted_arc_;                            // node arc lengths at the end of the step
   std::vector<double> solved_;  // Pa, the element pressures of the last implicit step (the next start)
-  std::vector<std::vector<std::pair<std::size_t, double>>> pieces_;      // per particle: (element, fraction) now
+  std::vector<std::vector<std::pair<std::size_t, double>>> pieces_;  // per particle: (element, fraction) now
   double interface_mismatch_ = 0, interface_residual_ = 0;
   int interface_iterations_ = 0;
-  std::uint64_t interface_merges_ = 0;      // particles merged because a step would have squeezed them
-  std::uint64_t interface_newton_ = 0;      // Newton iterations over the run
+  std::uint64_t interface_merges_ = 0;       // particles merged because a step would have squeezed them
+  std::uint64_t interface_newton_ = 0;       // Newton iterations over the run
   std::uint64_t interface_unconverged_ = 0;  // steps whose solve stopped above its tolerance
 };
 
