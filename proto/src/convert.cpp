@@ -86,27 +86,27 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
   const std::uint32_t id = crack.crack_id();
   const int n = crack.ids_size();
   if (n < 2) fail(type, id, "a crack needs at least 2 crack particles, got " + std::to_string(n));
-  check_length(type, id, "x", crack.x(), n);
-  check_length(type, id, "y", crack.y(), n);
-  check_length(type, id, "nx", crack.nx(), n);
-  check_length(type, id, "ny", crack.ny(), n);
-  check_length(type, id, "width", crack.width(), n);
+  // One value per id, each finite.
+  auto per_id = [&](const char* name, const auto& array) {
+    check_length(type, id, name, array, n);
+    check_finite(type, id, name, array);
+  };
+  per_id("x", crack.x());
+  per_id("y", crack.y());
+  per_id("nx", crack.nx());
+  per_id("ny", crack.ny());
+  per_id("width", crack.width());
   check_length(type, id, "tip", crack.tip(), n);
-  check_finite(type, id, "x", crack.x());
-  check_finite(type, id, "y", crack.y());
-  check_finite(type, id, "nx", crack.nx());
-  check_finite(type, id, "ny", crack.ny());
-  check_finite(type, id, "width", crack.width());
   check_unique_ids(type, id, crack.ids());
   const bool response =
       crack.opening_rate_size() > 0 || crack.opening_acceleration_size() > 0 || crack.opening_compliance_size() > 0;
-  if (!response && (crack.plane_rate_x_size() > 0 || crack.plane_rate_y_size() > 0 ||
-                    crack.plane_acceleration_x_size() > 0 || crack.plane_acceleration_y_size() > 0)) {
+  const bool plane = crack.plane_rate_x_size() > 0 || crack.plane_rate_y_size() > 0 ||
+                     crack.plane_acceleration_x_size() > 0 || crack.plane_acceleration_y_size() > 0;
+  if (plane && !response)
     fail(type, id, "plane_rate / plane_acceleration come only with the opening_* response arrays");
-  }
   if (response) {
-    check_length(type, id, "opening_rate", crack.opening_rate(), n);
-    check_length(type, id, "opening_acceleration", crack.opening_acceleration(), n);
+    per_id("opening_rate", crack.opening_rate());
+    per_id("opening_acceleration", crack.opening_acceleration());
     const std::uint32_t band = crack.opening_compliance_band();
     if (band >= static_cast<std::uint32_t>(n)) {
       fail(type, id,
@@ -120,19 +120,12 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
                std::to_string(n) + " ids and opening_compliance_band " + std::to_string(band) + " it needs " +
                std::to_string(expected) + " (ids x (2 band + 1))");
     }
-    check_finite(type, id, "opening_rate", crack.opening_rate());
-    check_finite(type, id, "opening_acceleration", crack.opening_acceleration());
     check_finite(type, id, "opening_compliance", crack.opening_compliance());
-    if (crack.plane_rate_x_size() > 0 || crack.plane_rate_y_size() > 0 || crack.plane_acceleration_x_size() > 0 ||
-        crack.plane_acceleration_y_size() > 0) {
-      check_length(type, id, "plane_rate_x", crack.plane_rate_x(), n);
-      check_length(type, id, "plane_rate_y", crack.plane_rate_y(), n);
-      check_length(type, id, "plane_acceleration_x", crack.plane_acceleration_x(), n);
-      check_length(type, id, "plane_acceleration_y", crack.plane_acceleration_y(), n);
-      check_finite(type, id, "plane_rate_x", crack.plane_rate_x());
-      check_finite(type, id, "plane_rate_y", crack.plane_rate_y());
-      check_finite(type, id, "plane_acceleration_x", crack.plane_acceleration_x());
-      check_finite(type, id, "plane_acceleration_y", crack.plane_acceleration_y());
+    if (plane) {
+      per_id("plane_rate_x", crack.plane_rate_x());
+      per_id("plane_rate_y", crack.plane_rate_y());
+      per_id("plane_acceleration_x", crack.plane_acceleration_x());
+      per_id("plane_acceleration_y", crack.plane_acceleration_y());
     }
   }
 

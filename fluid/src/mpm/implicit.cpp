@@ -219,8 +219,7 @@ void FluidSolver::step_implicit(double dt) {
   const double injected_before = injected_mass_;
   // Where the nodes will be at the end of the step (the plane's own motion).
   predicted_arc_.clear();
-  if (config_.implicit_interface && wall_plane_rate_.size() == n && wall_plane_acceleration_.size() == n &&
-      config_.implicit_interface) {
+  if (wall_plane_rate_.size() == n && wall_plane_acceleration_.size() == n) {
     std::vector<Vec2> x(n);
     for (std::size_t i = 0; i < n; ++i)
       x[i] = grid_.position()[i] + dt * (wall_plane_rate_[i] + dt * wall_plane_acceleration_[i]);
@@ -298,10 +297,7 @@ void FluidSolver::step_implicit(double dt) {
         Eigen::SparseMatrix<double> system(static_cast<Eigen::Index>(elements), static_cast<Eigen::Index>(elements));
         Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
         std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
-        double norm = min_form(P, g, phi);
-        // The best iterate so far is the answer.
-        std::vector<double> best_P = P, best_g = g, best_phi = phi;
-        double best_norm = norm;
+        double norm = min_form(P, g, phi);  // falls with every accepted step: the last iterate is the best
         for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
           ++interface_iterations_;
           for (auto& row : dg) row.clear();
@@ -309,25 +305,20 @@ void FluidSolver::step_implicit(double dt) {
           for (std::size_t colour = 0; colour < kColours && colour < elements; ++colour) {
             // A forward difference, or a backward one where the forward probe
             // squeezes a particle to nothing (P lies at the edge of the feasible set).
-            double step = delta;
             probe = P;
-            for (std::size_t e = colour; e < elements; e += kColours) probe[e] += step;
+            for (std::size_t e = colour; e < elements; e += kColours) probe[e] += delta;
             if (!interface_trial(probe, dt, trial, g_probe)) {
-              step = -delta;
-              for (std::size_t e = colour; e < elements; e += kColours) probe[e] = std::max(0.0, P[e] + step);
+              for (std::size_t e = colour; e < elements; e += kColours) probe[e] = std::max(0.0, P[e] - delta);
               if (!interface_trial(probe, dt, trial, g_probe)) fail("turns a particle inside out while probing");
             }
             for (std::size_t row = 0; row < elements; ++row) {
-              const std::size_t r0 = (row % kColours + kColours - colour) % kColours;
-              const std::size_t c0 = r0 <= kReach ? row - r0 : row + (kColours - r0);
-              const double moved = c0 < elements ? probe[c0] - P[c0] : 0.0;
-              if (moved == 0) continue;
-              const double d = (g_probe[row] - g[row]) / moved;
-              if (d == 0) continue;
               // The perturbed element of this colour nearest the row (one lies within kReach).
               const std::size_t r = (row % kColours + kColours - colour) % kColours;
               const std::size_t col = r <= kReach ? row - r : row + (kColours - r);
-              if (col < elements) dg[row].push_back({col, d});
+              const double moved = col < elements ? probe[col] - P[col] : 0.0;
+              if (moved == 0) continue;
+              const double d = (g_probe[row] - g[row]) / moved;
+              if (d != 0) dg[row].push_back({col, d});
             }
           }
           std::vector<Eigen::Triplet<double>> entries;
@@ -368,17 +359,8 @@ void FluidSolver::step_implicit(double dt) {
               break;
             }
           }
-          if (norm < best_norm) {
-            best_P = P;
-            best_g = g;
-            best_phi = phi;
-            best_norm = norm;
-          }
           if (!accepted) break;
         }
-        P.swap(best_P);
-        g.swap(best_g);
-        phi.swap(best_phi);
         interface_residual_ = max_abs(phi) * K;  // Pa
         interface_newton_ += static_cast<std::uint64_t>(interface_iterations_);
         if (max_abs(phi) > tolerance) ++interface_unconverged_;
