@@ -73,12 +73,6 @@ void for_pieces(const std::vector<double>& arc, double a, double b, Fn&& fn) {
   }
 }
 
-double sum_squares(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m += x * x;
-  return std::sqrt(m);
-}
-
 double max_abs(const std::vector<double>& v) {
   double m = 0;
   for (double x : v) m = std::max(m, std::abs(x));
