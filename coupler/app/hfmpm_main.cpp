@@ -8,6 +8,7 @@
 
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
+#include "hfmpm/coupling/stop_signals.hpp"
 #include "mpm_fluid_side.hpp"
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
@@ -36,7 +37,12 @@ options:
   --solid-program P    run another solid implementation (speaks docs/protocol.md)
   --fluid-program P    run another fluid implementation
   --quiet              no progress line
-exit status: 0 success, 1 run failed, 2 bad scene or command line
+  --help, -h           this text (also after a command: hfmpm run --help)
+exit status: 0 success, 1 run failed, 2 bad scene or command line,
+  128 + N stopped by signal N (130 SIGINT/Ctrl-C, 143 SIGTERM, 129 SIGHUP).
+  The first SIGINT, SIGTERM or SIGHUP stops the run at its next control
+  round: the sides shut down, outputs are flushed, run.json says
+  "interrupted" with the step. A second one ends everything at once.
 )";
 
 struct UsageError : std::runtime_error {
@@ -127,7 +133,13 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   options.scene_path = scene_path;
   options.overrides = overrides;
   options.inproc_factory = make_inproc_side;
+  options.stop_request = &coupling::install_stop_signals();
   const auto summary = coupling::run_coupled(scene, options);
+  if (summary.interrupted_by) {
+    std::cerr << "hfmpm: " << summary.error << "; the sides were shut down\n"
+              << "hfmpm: output written so far is in " << options.output_dir << " (run.json: \"interrupted\")\n";
+    return coupling::exit_status_for_signal(summary.interrupted_by);
+  }
   if (!summary.ok) {
     std::cerr << "hfmpm: run failed: " << summary.error << "\n"
               << "hfmpm: output written so far is in " << options.output_dir << "\n";
@@ -153,6 +165,12 @@ int main(int argc, char** argv) {
   }
   const std::string command = args[0];
   args.erase(args.begin());
+  for (const auto& arg : args) {
+    if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+  }
   try {
     if (command != "run" && command != "coupler" && command != "validate") {
       throw UsageError("unknown command '" + command + "'; allowed: run, coupler, validate");

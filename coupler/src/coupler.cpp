@@ -34,6 +34,7 @@ Coupler::Coupler(const scene::Scene& scene, const RunOptions& options)
 }
 
 Coupler::~Coupler() {
+  if (options_.stop_request) set_abort_cleanup({});
   for (auto& side : sides_) {
     if (side.thread.joinable()) side.thread.join();
   }
@@ -57,12 +58,25 @@ RunSummary Coupler::run() {
     summary.ok = true;
     manifest_.set("status", stopped_at_max_steps_ ? "stopped at time.max_steps" : "completed");
     report_rest();
+  } catch (const RunInterrupted& interrupted) {
+    // Asked to stop: the sides end as at the end of a run (their outputs
+    // flushed and closed), and the manifest says where the run stopped.
+    const std::string name = signal_name(interrupted.signal);
+    std::ostringstream out;
+    out << "interrupted by " << name << " at step " << step_ << " (t = " << t_ << " s)";
+    summary.error = out.str();
+    summary.interrupted_by = interrupted.signal;
+    log_.file_only(summary.error + "; stopping the sides");
+    stop_sides(false, summary.error);
+    manifest_.set("status", "interrupted");
+    manifest_.set("interrupted_by", name);
+    manifest_.set_number("interrupted_at_step", static_cast<double>(step_));
   } catch (const RunFailure& failure) {
     summary.error = failure.message;
   } catch (const std::exception& e) {
     summary.error = std::string("coupler: ") + e.what();
   }
-  if (!summary.ok) {
+  if (!summary.ok && !summary.interrupted_by) {
     log_.file_only("run failed: " + summary.error);
     stop_sides(true, summary.error);
     manifest_.set("status", "failed");
@@ -131,6 +145,11 @@ void Coupler::prepare() {
   manifest_.set("scene", options_.scene_path);
   manifest_.set("scene_name", scene_.name());
   manifest_.set("status", "starting");
+  // Who runs it, since when: a run.json left at "running" by a coupler that
+  // was killed (kill -9, a second signal) names a process that no longer exists.
+  manifest_.set_number("coupler_pid", static_cast<double>(getpid()));
+  manifest_.set("coupler_host", host_name());
+  manifest_.set("started_at", utc_now());
   std::string overrides;
   for (const auto& o : options_.overrides) overrides += (overrides.empty() ? "" : " ") + o;
   manifest_.set("overrides", overrides);
@@ -174,6 +193,27 @@ void Coupler::prepare() {
   }
   manifest_.set("control_endpoint", control_endpoint_);
   manifest_.set("output_dir", output_dir_);
+  if (options_.stop_request) {
+    // A second stop signal ends the process at once: leave no socket
+    // directory behind, and no run.json that says "running".
+    set_abort_cleanup([ipc = ipc_dir_, manifest = output_dir_ + "/run.json"](int signal) {
+      if (!ipc.empty()) {
+        std::error_code ignored;
+        fs::remove_all(ipc, ignored);
+      }
+      std::ifstream in(manifest);
+      std::ostringstream read;
+      read << in.rdbuf();
+      std::string text = read.str();
+      const auto at = text.find("\"status\": \"");
+      if (at == std::string::npos) return;
+      const auto end = text.find('"', at + 11);
+      text.replace(at, end + 1 - at, "\"status\": \"aborted by " + signal_name(signal) + "\"");
+      const std::string tmp = manifest + ".abort";
+      std::ofstream(tmp) << text;
+      std::rename(tmp.c_str(), manifest.c_str());
+    });
+  }
   if (options_.on_bound) options_.on_bound(control_endpoint_);
 
   if (options_.launch) {

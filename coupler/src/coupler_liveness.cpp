@@ -57,10 +57,17 @@ std::optional<std::pair<Side*, protocol::Envelope>> Coupler::pump(microseconds w
   return std::make_pair(side, envelope);
 }
 
+void Coupler::check_stop_request() const {
+  if (options_.stop_request) {
+    if (const int signal = options_.stop_request->load()) throw RunInterrupted{signal};
+  }
+}
+
 void Coupler::housekeeping() {
   const auto now = Clock::now();
   if (now - last_housekeeping_ < milliseconds(5)) return;
   last_housekeeping_ = now;
+  if (!stepping_) check_stop_request();  // while the sides join; in the loop, between rounds
   for (auto& side : sides_) {
     if (!side.expected || side.stopping) continue;
     if (side.process) {

@@ -144,7 +144,13 @@ void Coupler::step_loop(RunSummary& summary) {
   double next_output = interval;
   double mean_command_s = 0;
   const std::uint64_t max_steps = scene_.time().max_steps();
+  stepping_ = true;
   while (t_ < end * (1 - 1e-12)) {
+    if (options_.stop_request && options_.stop_request->load()) {
+      summary.stepping_wall_s = seconds_since(start);
+      history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+      check_stop_request();
+    }
     // Steps to reach the next output time (and the end), rounded up to whole exchange windows.
     auto steps_to = [&](double target) {
       const double n = std::ceil((target - t_) / dt * (1 - 1e-12));

@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <ctime>
 #include <filesystem>
 #include <functional>
 #include <iomanip>
@@ -24,6 +25,7 @@
 
 #include "hfmpm/coupling/process.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
+#include "hfmpm/coupling/stop_signals.hpp"
 #include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
 #include "run_output.hpp"
@@ -39,6 +41,11 @@ inline constexpr double kInf = std::numeric_limits<double>::infinity();
 // A run cannot go on; the text names the side, the step and what happened.
 struct RunFailure {
   std::string message;
+};
+
+// The operator asked the run to stop (a signal; RunOptions::stop_request).
+struct RunInterrupted {
+  int signal;
 };
 
 struct Side {
@@ -77,6 +84,16 @@ inline std::string host_name() {
   return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
 }
 
+// ISO 8601, UTC, to the second: 2026-12-03T02:41:07Z.
+inline std::string utc_now() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32] = {};
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
 inline bool loopback(const std::string& host) {
   return host == "localhost" || host.rfind("127.", 0) == 0 || host == "::1";
 }
@@ -103,6 +120,8 @@ class Coupler {
   // One message from a side, or nullopt after `wait`; runs the liveness checks.
   std::optional<std::pair<Side*, protocol::Envelope>> pump(microseconds wait);
   void housekeeping();
+  // Throws RunInterrupted if a stop was requested.
+  void check_stop_request() const;
   std::string ended_message(Side& side, const std::string& ended);
 
   // After a side ended: its last words, if it sent an Error before going.
@@ -136,6 +155,7 @@ class Coupler {
   bool prepared_ = false;
   bool leak_context_ = false;
   bool stopped_at_max_steps_ = false;
+  bool stepping_ = false;  // in the step loop: stop requests are taken between control rounds
   // Largest fluid pressure change at frozen crack width over a report, and when (run.json).
   double max_coupling_lag_ = 0, max_coupling_lag_t_ = 0;
   std::string dt_limit_;                                 // "side: term" that set the last step

@@ -39,6 +39,14 @@ ChildProcess::ChildProcess(const std::string& program, const std::vector<std::st
   if (pid_ == 0) {
     prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(127);  // the coupler died before prctl
+    // The coupler takes SIGINT/SIGTERM/SIGHUP (stop_signals.hpp) and shuts
+    // the sides down in order: a side runs with the signals unblocked (the
+    // mask survives exec) and in its own process group, so that Ctrl-C at
+    // the terminal reaches the coupler only.
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    setpgid(0, 0);
     dup2(log, STDOUT_FILENO);
     dup2(log, STDERR_FILENO);
     execv(program.c_str(), argv.data());

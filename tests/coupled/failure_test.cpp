@@ -234,5 +234,75 @@ TEST(Failure, StrangersOnTheControlPortAreIgnored) {
   expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
 }
 
+// SIGINT, SIGTERM and SIGHUP stop `hfmpm run` at its next control round: the
+// sides shut down in order, run.json says "interrupted" with the step, the
+// history and the HDF5-free stand-in outputs stay readable, the ipc
+// directory is removed, and the exit status is 128 + the signal.
+void interrupt_mid_run(int signal, const std::string& name) {
+  const auto out = scratch_dir("interrupted");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  Process coupler({bin("hfmpm"), "run", scene, "--out", out, "--quiet"});
+  pid_t solid = 0, fluid = 0;
+  for (int i = 0; i < 500 && history_rows(out) < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::string started = read_file(out + "/run.json");
+  solid = static_cast<pid_t>(json_number(started, "solid_pid"));
+  fluid = static_cast<pid_t>(json_number(started, "fluid_pid"));
+  const std::string endpoint = json_string(started, "control_endpoint");
+  ASSERT_EQ(endpoint.rfind("ipc://", 0), 0u) << endpoint;
+  const std::string ipc_dir = std::filesystem::path(endpoint.substr(6)).parent_path().string();
+  EXPECT_TRUE(std::filesystem::exists(ipc_dir));
+  EXPECT_EQ(json_number(started, "coupler_pid"), coupler.pid());
+  kill(coupler.pid(), signal);
+  ASSERT_TRUE(coupler.wait(20));
+  EXPECT_EQ(coupler.exit_code(), 128 + signal) << coupler.err();
+  EXPECT_NE(coupler.err().find("interrupted by " + name + " at step"), std::string::npos) << coupler.err();
+  const std::string manifest = read_file(out + "/run.json");
+  EXPECT_EQ(json_string(manifest, "status"), "interrupted");
+  EXPECT_EQ(json_string(manifest, "interrupted_by"), name);
+  const double step = json_number(manifest, "interrupted_at_step");
+  EXPECT_GT(step, 0);
+  // The history ends with the step the run stopped at.
+  const Csv history = read_csv(out + "/history.csv");
+  ASSERT_GE(history.rows.size(), 3u);
+  EXPECT_EQ(history.rows.back()[history.column("step")], step);
+  // The sides were shut down (not killed) and are gone; so is the socket directory.
+  EXPECT_FALSE(pid_alive(solid));
+  EXPECT_FALSE(pid_alive(fluid));
+  EXPECT_EQ(read_file(out + "/solid.log").find("killed"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(ipc_dir));
+}
+
+TEST(Failure, SigintStopsTheRunInOrder) { interrupt_mid_run(SIGINT, "SIGINT"); }
+TEST(Failure, SigtermStopsTheRunInOrder) { interrupt_mid_run(SIGTERM, "SIGTERM"); }
+TEST(Failure, SighupStopsTheRunInOrder) { interrupt_mid_run(SIGHUP, "SIGHUP"); }
+
+// A second signal ends the run at once; the sides die with the coupler, the
+// socket directory is removed, and run.json does not say "running".
+TEST(Failure, ASecondSignalStopsAtOnce) {
+  const auto out = scratch_dir("aborted");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  Process coupler({bin("hfmpm"), "run", scene, "--out", out, "--quiet"});
+  for (int i = 0; i < 500 && history_rows(out) < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const std::string started = read_file(out + "/run.json");
+  const auto solid = static_cast<pid_t>(json_number(started, "solid_pid"));
+  const std::string ipc_dir =
+      std::filesystem::path(json_string(started, "control_endpoint").substr(6)).parent_path().string();
+  // Stop the sides from answering, so the first signal's orderly stop cannot finish first.
+  kill(solid, SIGSTOP);
+  kill(coupler.pid(), SIGTERM);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  kill(coupler.pid(), SIGTERM);
+  ASSERT_TRUE(coupler.wait(10));
+  EXPECT_EQ(coupler.exit_code(), 128 + SIGTERM) << coupler.err();
+  EXPECT_NE(coupler.err().find("SIGTERM again: stopping at once"), std::string::npos) << coupler.err();
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "aborted by SIGTERM");
+  for (int i = 0; i < 200 && pid_alive(solid); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_FALSE(pid_alive(solid));
+  EXPECT_FALSE(std::filesystem::exists(ipc_dir));
+  EXPECT_GE(read_csv(out + "/history.csv").rows.size(), 1u);
+}
+
 }  // namespace
 }  // namespace hfmpm::test

@@ -4,6 +4,7 @@
 // everything on any failure. It has no physics.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -32,11 +33,16 @@ struct RunOptions {
   std::string scene_path;       // for the manifest
   std::vector<std::string> overrides;
   std::function<void(const std::string&)> on_bound;  // told the bound control endpoint
+  // A stop request (install_stop_signals): 0, or the signal that asked the
+  // run to stop. Read before each control round and while waiting for the
+  // sides to join; the run then ends "interrupted".
+  const std::atomic<int>* stop_request = nullptr;
 };
 
 struct RunSummary {
   bool ok = false;
   std::string error;  // names the failed side and step
+  int interrupted_by = 0;  // the signal that stopped the run (error says so), or 0
   std::uint64_t steps = 0;
   std::uint64_t commands = 0;
   double t = 0;
