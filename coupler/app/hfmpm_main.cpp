@@ -2,11 +2,13 @@
 // started by hand, or validate a scene. Thin: parse, load, run, report.
 #include <google/protobuf/text_format.h>
 
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <map>
 
 #include "hfmpm/coupling/coupler.hpp"
+#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
 #include "mpm_fluid_side.hpp"
@@ -21,11 +23,16 @@ using namespace hfmpm;
 constexpr const char* kUsage = R"(usage:
   hfmpm run SCENE [--out DIR] [--set KEY=VALUE]... [--transport ipc|tcp|inproc] [--quiet]
       Start the coupler and both sides, run SCENE to its end time, write DIR/history.csv.
-  hfmpm coupler SCENE --bind ENDPOINT [--out DIR] [--set KEY=VALUE]... [--quiet]
+  hfmpm coupler SCENE --bind ENDPOINT [--keys FILE] [--out DIR] [--set KEY=VALUE]... [--quiet]
       Run the coupler only and wait for the sides to join, e.g. from other hosts:
-        hfmpm coupler s.scene --bind tcp://0.0.0.0:5555
-        hfmpm-prescribed-solid --connect tcp://COUPLER_HOST:5555   (on the solid's host)
-        hfmpm-prescribed-fluid --connect tcp://COUPLER_HOST:5555   (on the fluid's host)
+        hfmpm keygen keys      (once; copy keys/side.keys to the sides' hosts)
+        hfmpm coupler s.scene --bind tcp://0.0.0.0:5555 --keys keys/coupler.keys
+        hfmpm-solid --connect tcp://COUPLER_HOST:5555 --keys side.keys   (on the solid's host)
+        hfmpm-fluid --connect tcp://COUPLER_HOST:5555 --keys side.keys   (on the fluid's host)
+  hfmpm keygen DIR
+      Write a CURVE key pair for the coupler and one for the sides: DIR/coupler.keys
+      and DIR/side.keys (0600, DIR 0700). A coupler on tcp admits only sides that
+      hold side.keys; nothing secret goes into run.json or onto a command line.
   hfmpm validate SCENE [--set KEY=VALUE]...
       Check SCENE and print it with every default filled in.
 
@@ -34,6 +41,9 @@ options:
   --set KEY=VALUE      override one scene value, e.g. --set time.end_s=2
                        --set coupling.transport=TCP; repeated fields take [a, b]
   --transport T        same as --set coupling.transport=T (ipc, tcp or inproc)
+  --keys FILE          coupler on tcp: its key file (coupler.keys from hfmpm keygen)
+  --insecure-tcp       plain tcp without CURVE, for sides that cannot do it: anyone
+                       who can reach the port can join. 'run' makes keys itself.
   --solid-program P    run another solid implementation (speaks docs/protocol.md)
   --fluid-program P    run another fluid implementation
   --quiet              no progress line
@@ -80,6 +90,30 @@ void fill_defaults(google::protobuf::Message& message) {
   }
 }
 
+int keygen(const std::vector<std::string>& args) {
+  if (args.size() != 1 || args[0].empty() || args[0][0] == '-') {
+    throw UsageError("'hfmpm keygen' takes one directory: hfmpm keygen DIR");
+  }
+  const std::filesystem::path dir = args[0];
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir)) {
+    throw std::runtime_error("cannot create the directory '" + dir.string() + "': " + error.message());
+  }
+  std::filesystem::permissions(dir, std::filesystem::perms::owner_all, error);
+  for (const char* name : {"coupler.keys", "side.keys"}) {
+    if (std::filesystem::exists(dir / name)) {
+      throw std::runtime_error("'" + (dir / name).string() + "' exists; keygen does not overwrite keys");
+    }
+  }
+  const auto keys = coupling::generate_curve_keys();
+  coupling::write_coupler_key_file((dir / "coupler.keys").string(), keys);
+  coupling::write_side_key_file((dir / "side.keys").string(), keys);
+  std::cout << "hfmpm: wrote " << (dir / "coupler.keys").string() << " (keep it with the coupler: --keys) and "
+            << (dir / "side.keys").string() << " (copy it to each side's host: --keys)\n";
+  return 0;
+}
+
 int run(const std::string& command, const std::vector<std::string>& args) {
   std::string scene_path, out, bind;
   std::vector<std::string> overrides;
@@ -90,10 +124,17 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       if (i + 1 >= args.size()) throw UsageError("option " + arg + " needs a value");
       return args[++i];
     };
-    if (arg == "--out") out = value();
+    if (arg == "--out") {
+      out = value();
+      if (out.empty()) {
+        throw UsageError("--out needs a directory; an empty one is not allowed (omit --out for hfmpm-out/SCENE_NAME)");
+      }
+    }
     else if (arg == "--set") overrides.push_back(value());
     else if (arg == "--bind") bind = value();
     else if (arg == "--quiet") options.progress = false;
+    else if (arg == "--keys") options.keys_file = value();
+    else if (arg == "--insecure-tcp") options.insecure_tcp = true;
     else if (arg == "--solid-program") options.solid_program = value();
     else if (arg == "--fluid-program") options.fluid_program = value();
     else if (arg == "--transport") {
@@ -118,6 +159,9 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     std::cout << "# " << scene_path << ": valid\n" << text;
     return 0;
   }
+  if (!options.keys_file.empty() && command != "coupler") {
+    throw UsageError("--keys is for 'hfmpm coupler'; 'hfmpm run' makes keys for the sides it starts");
+  }
   if (command == "coupler") {
     if (bind.empty()) throw UsageError("'hfmpm coupler' needs --bind ENDPOINT (e.g. tcp://0.0.0.0:5555)");
     options.launch = false;
@@ -141,8 +185,13 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     return coupling::exit_status_for_signal(summary.interrupted_by);
   }
   if (!summary.ok) {
-    std::cerr << "hfmpm: run failed: " << summary.error << "\n"
-              << "hfmpm: output written so far is in " << options.output_dir << "\n";
+    std::cerr << "hfmpm: run failed: " << summary.error << "\n";
+    std::error_code exists_error;  // only point at a directory that is there
+    if (std::filesystem::is_directory(options.output_dir, exists_error)) {
+      std::cerr << "hfmpm: output written so far is in " << options.output_dir << "\n";
+    } else {
+      std::cerr << "hfmpm: no output: the directory " << options.output_dir << " was not created\n";
+    }
     return 1;
   }
   std::cout << std::setprecision(4) << "hfmpm: done: " << summary.steps << " steps to t = " << summary.t << " s in "
@@ -172,8 +221,9 @@ int main(int argc, char** argv) {
     }
   }
   try {
+    if (command == "keygen") return keygen(args);
     if (command != "run" && command != "coupler" && command != "validate") {
-      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, validate");
+      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, validate, keygen");
     }
     return run(command, args);
   } catch (const UsageError& e) {

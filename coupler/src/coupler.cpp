@@ -45,6 +45,10 @@ Coupler::~Coupler() {
     std::error_code ignored;
     fs::remove_all(ipc_dir_, ignored);
   }
+  if (!keys_dir_.empty()) {
+    std::error_code ignored;
+    fs::remove_all(keys_dir_, ignored);
+  }
 }
 
 RunSummary Coupler::run() {
@@ -175,6 +179,37 @@ void Coupler::prepare() {
       data_bind_ = "ipc://" + ipc_dir_ + "/data";
     }
   }
+  std::string side_keys;  // the key file the launched sides get
+  if (bind.rfind("tcp://", 0) == 0) {
+    if (options_.insecure_tcp) {
+      manifest_.set("tcp_security", "none (--insecure-tcp): anyone who reaches the port can join");
+      log_.file_only("warning: plain tcp (--insecure-tcp): anyone who can reach " + bind + " can join as a side");
+    } else {
+      CurveKeys keys;
+      if (!options_.keys_file.empty()) {
+        keys = read_coupler_key_file(options_.keys_file);
+      } else if (options_.launch) {
+        keys = generate_curve_keys();  // this run's own
+      } else {
+        throw RunFailure{"a coupler on tcp needs --keys FILE (the coupler.keys that 'hfmpm keygen DIR' writes; "
+                         "the sides take side.keys), or --insecure-tcp for plain tcp"};
+      }
+      if (options_.launch) {
+        char pattern[] = "/tmp/hfmpm-keys-XXXXXX";  // 0700
+        if (!mkdtemp(pattern)) throw RunFailure{"cannot create a private directory for the run's keys in /tmp"};
+        keys_dir_ = pattern;
+        side_keys = keys_dir_ + "/side.keys";
+        write_side_key_file(side_keys, keys);
+      }
+      zap_ = std::make_unique<ZapAuthenticator>(*context_, keys.client_public, [this](const std::string& line) {
+        std::lock_guard<std::mutex> lock(refusals_mutex_);
+        refusals_ += (refusals_.empty() ? "" : "\n") + line;
+      });
+      make_curve_server(router_, keys.server_secret);
+      manifest_.set("tcp_security", "CURVE");
+    }
+  }
+  side_keys_ = side_keys;
   try {
     router_.bind(bind);
   } catch (const zmq::error_t& e) {
@@ -196,10 +231,10 @@ void Coupler::prepare() {
   if (options_.stop_request) {
     // A second stop signal ends the process at once: leave no socket
     // directory behind, and no run.json that says "running".
-    set_abort_cleanup([ipc = ipc_dir_, manifest = output_dir_ + "/run.json"](int signal) {
-      if (!ipc.empty()) {
+    set_abort_cleanup([ipc = ipc_dir_, keys = keys_dir_, manifest = output_dir_ + "/run.json"](int signal) {
+      for (const auto& dir : {ipc, keys}) {
         std::error_code ignored;
-        fs::remove_all(ipc, ignored);
+        if (!dir.empty()) fs::remove_all(dir, ignored);
       }
       std::ifstream in(manifest);
       std::ostringstream read;
@@ -259,6 +294,10 @@ void Coupler::launch_sides() {
       continue;
     }
     std::vector<std::string> args{"--connect", control_endpoint_, "--out", output_dir_};
+    if (!side_keys_.empty()) {
+      args.push_back("--keys");
+      args.push_back(side_keys_);
+    }
     const auto& extra = side.role == protocol::SOLID ? scene_.coupling().solid_args() : scene_.coupling().fluid_args();
     args.insert(args.end(), extra.begin(), extra.end());
     side.log_path = output_dir_ + "/" + side.name + ".log";

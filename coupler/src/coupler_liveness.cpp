@@ -24,8 +24,15 @@ std::optional<std::pair<Side*, protocol::Envelope>> Coupler::pump(microseconds w
   Side* side = side_named(base);
   const bool heartbeat_socket = dot != std::string::npos && routed->peer.substr(dot) == ".hb";
   if (!side || (dot != std::string::npos && !heartbeat_socket)) {
-    log_("ignored a message from an unknown peer '" + routed->peer + "' (" + std::to_string(routed->payload.size()) +
-         " bytes); only the solid and fluid sides may talk to the coupler");
+    // Logged the first time and then at most once a second, with a count.
+    ++strangers_;
+    const auto now = Clock::now();
+    if (strangers_ == 1 || now - last_stranger_log_ > std::chrono::seconds(1)) {
+      log_("ignored a message from an unknown peer '" + printable(routed->peer) + "' (" +
+           std::to_string(routed->payload.size()) + " bytes; " + std::to_string(strangers_) +
+           " from strangers so far); only the solid and fluid sides may talk to the coupler");
+      last_stranger_log_ = now;
+    }
     return std::nullopt;
   }
   protocol::Envelope envelope;
@@ -68,6 +75,14 @@ void Coupler::housekeeping() {
   if (now - last_housekeeping_ < milliseconds(5)) return;
   last_housekeeping_ = now;
   if (!stepping_) check_stop_request();  // while the sides join; in the loop, between rounds
+  if (zap_) {
+    std::string refusals;
+    {
+      std::lock_guard<std::mutex> lock(refusals_mutex_);
+      refusals.swap(refusals_);
+    }
+    if (!refusals.empty()) log_.file_only(refusals);
+  }
   for (auto& side : sides_) {
     if (!side.expected || side.stopping) continue;
     if (side.process) {
@@ -82,8 +97,8 @@ void Coupler::housekeeping() {
     if (side.joined && now - side.last_heard > heartbeat_timeout_) {
       std::ostringstream out;
       out << "the " << side.name << " side stopped answering" << at_step() << ": nothing from it for "
-          << scene_.coupling().heartbeat_timeout_s() << " s (its last heartbeat was at step "
-          << side.heartbeat_step << ")" << log_hint(side);
+          << scene_.coupling().heartbeat_timeout_s() << " s (its last heartbeat was at step " << side.heartbeat_step
+          << ")" << log_hint(side);
       throw RunFailure{out.str()};
     }
     if (side.joined && now - side.last_sent > heartbeat_interval_) {

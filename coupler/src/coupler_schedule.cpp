@@ -125,6 +125,38 @@ double Coupler::next_dt() {
   return scene_.time().safety_factor() * stable;
 }
 
+namespace {
+
+// The first step against time.end_s: a run of more than kMaxRunSteps steps
+// (or of a number of steps a double cannot count) is refused, naming the
+// step, where it comes from and the end time. Returns a warning when a single
+// step reaches past end_s (the run then ends at t + dt, not at end_s; the
+// validator refuses that when it can see every side's step, but an MPM
+// fluid reports its step only now); empty otherwise.
+std::string check_step_count(const scene::Scene& scene, double t, double dt, double end, const std::string& limit,
+                             const std::string& at_step) {
+  const double steps = (end - t) / dt;
+  std::ostringstream where;
+  where << "dt = " << dt << " s (time.safety_factor " << scene.time().safety_factor() << " x the stable step of the "
+        << limit << ") and time.end_s = " << end << " s";
+  if (!std::isfinite(steps) || steps > kMaxRunSteps) {
+    std::ostringstream out;
+    out << "the run would need " << steps << " steps to reach time.end_s: " << where.str() << "; at most "
+        << kMaxRunSteps << " steps are allowed (check the scene's moduli, densities and cell sizes, or shorten "
+        << "time.end_s)" << at_step;
+    throw RunFailure{out.str()};
+  }
+  if (dt > end - t) {
+    std::ostringstream out;
+    out << "warning: a single step reaches the end: " << where.str()
+        << "; the run is one step and ends at t = " << t + dt << " s, past time.end_s";
+    return out.str();
+  }
+  return {};
+}
+
+}  // namespace
+
 void Coupler::step_loop(RunSummary& summary) {
   History& history = *history_;
   const auto start = Clock::now();
@@ -133,6 +165,7 @@ void Coupler::step_loop(RunSummary& summary) {
   const std::uint32_t k = sides_[1].expected ? scene_.coupling().exchange_interval() : 1;
   const std::uint64_t block = (std::uint64_t{scene_.coupling().control_interval()} + k - 1) / k * k;
   double dt = next_dt();
+  if (const auto warning = check_step_count(scene_, t_, dt, end, dt_limit_, at_step()); !warning.empty()) log_(warning);
   history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
   if (sides_[1].expected) {
     energy_ = std::make_unique<EnergyWatch>(scene_.coupling().energy_bound());
@@ -153,7 +186,8 @@ void Coupler::step_loop(RunSummary& summary) {
     }
     // Steps to reach the next output time (and the end), rounded up to whole exchange windows.
     auto steps_to = [&](double target) {
-      const double n = std::ceil((target - t_) / dt * (1 - 1e-12));
+      // Clamped before the cast: a double above 2^64 (or inf) converts to garbage, often 0.
+      const double n = std::min(std::ceil((target - t_) / dt * (1 - 1e-12)), 1e18);
       const auto steps = static_cast<std::uint64_t>(std::max(1.0, n));
       return (steps + k - 1) / k * k;
     };

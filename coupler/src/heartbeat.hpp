@@ -7,10 +7,12 @@
 #include <condition_variable>
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <zmq.hpp>
 
+#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/proto/envelope.hpp"
 
 namespace hfmpm::coupling {
@@ -23,11 +25,13 @@ constexpr double kFirstHeartbeatIntervalS = 0.1;
 class HeartbeatThread {
  public:
   HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role,
-                  const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting)
-      : thread_([this, &context, endpoint, role, &step, &waiting] {
+                  const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting,
+                  std::optional<CurveKeys> curve)
+      : thread_([this, &context, endpoint, role, &step, &waiting, curve] {
           zmq::socket_t socket(context, zmq::socket_type::dealer);
           socket.set(zmq::sockopt::linger, 0);
           socket.set(zmq::sockopt::routing_id, std::string(proto::role_name(role)) + ".hb");
+          if (curve) make_curve_client(socket, curve->server_public, curve->client_public, curve->client_secret);
           socket.connect(endpoint);
           std::uint64_t sequence = 0;
           std::unique_lock lock(mutex_);

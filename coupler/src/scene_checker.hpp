@@ -53,6 +53,12 @@ void check_time_function(Checker& c, const std::string& key, const scene::TimeFu
                          const std::string& unit);
 // Rules for solid.mpm (scene_validate_mpm.cpp).
 void check_mpm_solid(Checker& c, const scene::MpmSolid& m);
+// The MPM solid's stable step, cfl h / c_p of its fastest material (density
+// scaled) as the solid computes it; NaN if the values needed are invalid.
+double mpm_solid_stable_dt(const scene::MpmSolid& m);
+// Grid nodes and (an upper bound on) the particles the MPM solid makes.
+double mpm_solid_nodes(const scene::MpmSolid& m);
+double mpm_solid_particles(const scene::MpmSolid& m);
 // Rules for fluid.mpm, including how it fits the solid's cracks (scene_validate_fluid.cpp).
 void check_mpm_fluid(Checker& c, const scene::Scene& s);
 

@@ -4,8 +4,11 @@
 #include <google/protobuf/io/tokenizer.h>
 #include <google/protobuf/text_format.h>
 
+#include <algorithm>
+#include <cctype>
+
+#include <filesystem>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -13,6 +16,44 @@ namespace hfmpm::coupling {
 namespace {
 
 namespace pb = google::protobuf;
+
+// Longest scene file and longest --set assignment read (a scene is a few kB).
+constexpr std::size_t kMaxSceneBytes = std::size_t{16} << 20;
+constexpr std::size_t kMaxAssignmentBytes = std::size_t{64} << 10;
+
+// The text between `prefix` (which ends with an opening quote) and the next
+// '"', at the first place `prefix` occurs in `message` and is followed by a
+// closing quote. `from` is where the search starts; `end` gets the position
+// after the closing quote.
+bool quoted_after(const std::string& message, const std::string& prefix, std::string& out, std::size_t from = 0,
+                  std::size_t* end = nullptr) {
+  const auto start = message.find(prefix, from);
+  if (start == std::string::npos) return false;
+  const auto first = start + prefix.size();
+  const auto close = message.find('"', first);
+  if (close == std::string::npos) return false;
+  out = message.substr(first, close - first);
+  if (end) *end = close + 1;
+  return true;
+}
+
+// Parses protobuf's 'Message type "T" has no field named "K"' (T of
+// [A-Za-z0-9_.]+), wherever it is in `message`.
+bool unknown_field(const std::string& message, std::string& type, std::string& key) {
+  const std::string prefix = "Message type \"";
+  const std::string middle = " has no field named \"";
+  for (std::size_t from = 0; from < message.size();) {
+    std::size_t after = 0;
+    if (!quoted_after(message, prefix, type, from, &after)) return false;
+    from = message.find(prefix, from) + 1;
+    const bool type_ok = !type.empty() && std::all_of(type.begin(), type.end(), [](char ch) {
+      return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '.';
+    });
+    if (!type_ok || message.compare(after, middle.size(), middle) != 0) continue;
+    if (quoted_after(message, middle, key, after)) return true;
+  }
+  return false;
+}
 
 std::string join(const std::vector<std::string>& items, const std::string& separator) {
   std::string out;
@@ -34,15 +75,14 @@ class Collector : public pb::io::ErrorCollector {
   void AddError(int line, pb::io::ColumnNumber column, const std::string& message) override {
     // Protobuf places an unknown enum value at the token after it, which may
     // be on the next line: point at the last line up to there that holds it.
-    static const std::regex bad_enum(R"re(Unknown enumeration value of "([^"]*)")re");
-    std::smatch e;
-    if (std::regex_search(message, e, bad_enum)) line = line_of_token_before(e[1].str(), line);
+    // (Plain string scanning: the message quotes user text, of any length.)
+    std::string token;
+    if (quoted_after(message, "Unknown enumeration value of \"", token)) line = line_of_token_before(token, line);
     std::string text = name_ + ":" + std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message;
-    static const std::regex unknown(R"re(Message type "([A-Za-z0-9_.]+)" has no field named "([^"]*)")re");
-    std::smatch m;
-    if (std::regex_search(message, m, unknown)) {
-      if (const auto* type = pb::DescriptorPool::generated_pool()->FindMessageTypeByName(m[1].str())) {
-        text = name_ + ":" + std::to_string(line + 1) + ": unknown key '" + m[2].str() + "' in " + type->name() +
+    std::string type_name, key;
+    if (unknown_field(message, type_name, key)) {
+      if (const auto* type = pb::DescriptorPool::generated_pool()->FindMessageTypeByName(type_name)) {
+        text = name_ + ":" + std::to_string(line + 1) + ": unknown key '" + key + "' in " + type->name() +
                "; allowed: " + field_names(type);
       }
     }
@@ -117,6 +157,11 @@ SceneError::SceneError(const std::vector<std::string>& problems)
     : std::runtime_error(join(problems, "\n")), problems_(problems) {}
 
 void apply_override(scene::Scene& scene, const std::string& assignment) {
+  if (assignment.size() > kMaxAssignmentBytes) {
+    throw SceneError({"--set " + assignment.substr(0, std::min<std::size_t>(assignment.find('='), 100)) + ": " +
+                      std::to_string(assignment.size()) + " characters; an override may have at most " +
+                      std::to_string(kMaxAssignmentBytes)});
+  }
   const auto equals = assignment.find('=');
   if (equals == std::string::npos || equals == 0) {
     throw SceneError({"--set " + assignment + ": expected KEY=VALUE, e.g. --set time.end_s=2"});
@@ -167,7 +212,19 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
   }
 }
 
-scene::Scene parse_scene(const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
+scene::Scene parse_scene(const std::string& file_text, const std::string& name,
+                         const std::vector<std::string>& overrides) {
+  if (file_text.size() > kMaxSceneBytes) {
+    throw SceneError({name + ": " + std::to_string(file_text.size()) + " bytes; a scene file may have at most " +
+                      std::to_string(kMaxSceneBytes)});
+  }
+  // A UTF-8 byte order mark (some Windows editors write one) is skipped; a
+  // UTF-16 file is refused by name rather than by the parser's first complaint.
+  const std::string bom = "\xEF\xBB\xBF";
+  const std::string text = file_text.compare(0, bom.size(), bom) == 0 ? file_text.substr(bom.size()) : file_text;
+  if (text.size() >= 2 && ((text[0] == '\xFF' && text[1] == '\xFE') || (text[0] == '\xFE' && text[1] == '\xFF'))) {
+    throw SceneError({name + ": the file is UTF-16 (it starts with a UTF-16 byte order mark); save it as UTF-8"});
+  }
   scene::Scene scene;
   pb::TextFormat::Parser parser;
   Collector collector(name, text);
@@ -193,8 +250,15 @@ scene::Scene parse_scene(const std::string& text, const std::string& name, const
 }
 
 scene::Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
+  std::error_code error;
+  if (std::filesystem::is_directory(path, error)) throw SceneError({path + ": is a directory, not a scene file"});
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw SceneError({path + ": cannot read the scene file (does it exist?)"});
+  const auto size = std::filesystem::file_size(path, error);
+  if (!error && size > kMaxSceneBytes) {
+    throw SceneError({path + ": " + std::to_string(size) + " bytes; a scene file may have at most " +
+                      std::to_string(kMaxSceneBytes)});
+  }
   std::stringstream text;
   text << in.rdbuf();
   return parse_scene(text.str(), path, overrides);

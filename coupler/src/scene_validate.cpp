@@ -1,8 +1,12 @@
 // The rules a scene must satisfy before any process starts. Each rule names
 // the key and what is allowed; the loader adds file and line.
+#include <google/protobuf/descriptor.h>
+#include <google/protobuf/message.h>
+
+#include <algorithm>
 #include <cmath>
 #include <limits>
-#include <regex>
+#include <set>
 #include <sstream>
 
 #include "hfmpm/coupling/scene_loader.hpp"
@@ -169,13 +173,132 @@ void check_prescribed_pressure(Checker& c, const scene::PrescribedPressure& p) {
     c.positive(key + "stable_dt_s", p.stable_dt_s(), "s");
 }
 
+// Every double and float field set anywhere in `message` (repeated and
+// nested ones included) that is NaN or infinite, as problems keyed by its path
+// ("solid.mpm.cracks[0].x_m[1]"). By reflection, so a new field is covered
+// without code here.
+void check_finite(Checker& c, const google::protobuf::Message& message, const std::string& prefix) {
+  namespace pb = google::protobuf;
+  const auto* reflection = message.GetReflection();
+  std::vector<const pb::FieldDescriptor*> fields;
+  reflection->ListFields(message, &fields);
+  const std::string allowed = "a finite number: every number in a scene must be finite";
+  for (const auto* field : fields) {
+    const std::string key = prefix + field->name();
+    const int count = field->is_repeated() ? reflection->FieldSize(message, field) : 1;
+    for (int i = 0; i < count; ++i) {
+      const std::string k = field->is_repeated() ? key + "[" + std::to_string(i) + "]" : key;
+      switch (field->cpp_type()) {
+        case pb::FieldDescriptor::CPPTYPE_DOUBLE: {
+          const double v = field->is_repeated() ? reflection->GetRepeatedDouble(message, field, i)
+                                                : reflection->GetDouble(message, field);
+          if (!std::isfinite(v)) c.bad(k, text(v), allowed);
+          break;
+        }
+        case pb::FieldDescriptor::CPPTYPE_FLOAT: {
+          const double v = field->is_repeated() ? reflection->GetRepeatedFloat(message, field, i)
+                                                : reflection->GetFloat(message, field);
+          if (!std::isfinite(v)) c.bad(k, text(v), allowed);
+          break;
+        }
+        case pb::FieldDescriptor::CPPTYPE_MESSAGE:
+          check_finite(c,
+                       field->is_repeated() ? reflection->GetRepeatedMessage(message, field, i)
+                                            : reflection->GetMessage(message, field),
+                       k + ".");
+          break;
+        default:
+          break;
+      }
+    }
+  }
+}
+
+// The name is used as a directory and file name: letters, digits, '_', '.',
+// '-', at most kMaxNameLength of them, and not "." or "..". Plain scanning
+// (no std::regex: its recursion overflows the stack on long input).
+constexpr std::size_t kMaxNameLength = 100;
+
+void check_name(Checker& c, const scene::Scene& s) {
+  if (!s.has_name()) return;
+  const std::string& name = s.name();
+  const bool chars_ok = !name.empty() && std::all_of(name.begin(), name.end(), [](char ch) {
+    return (ch >= 'A' && ch <= 'Z') || (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_' || ch == '.' ||
+           ch == '-';
+  });
+  const std::string shown = name.size() > 60
+                                ? "\"" + name.substr(0, 40) + "...\" (" + std::to_string(name.size()) + " characters)"
+                                : "\"" + name + "\"";
+  if (!chars_ok) {
+    c.bad("name", shown, "letters, digits, '_', '.', '-' (it is used in file names)");
+  } else if (name.size() > kMaxNameLength) {
+    c.bad("name", shown, "at most " + std::to_string(kMaxNameLength) + " characters (it is used in file names)");
+  } else if (name == "." || name == "..") {
+    c.bad("name", shown, "a name that is not \".\" or \"..\" (it is used as the output directory under hfmpm-out/)");
+  }
+}
+
+// The number of steps to time.end_s, from the stable steps known before any
+// process starts (the MPM solid's cfl h / c_p, the stand-ins' stable_dt_s;
+// the MPM fluid's step is known only once it runs, and can only be smaller).
+// Refused: more than kMaxRunSteps, or not finite (E = 1e300 gives a step of
+// 1e-150 s); and, when every side's step is known, a single step that is
+// longer than end_s (the run would end at that step's end, not at end_s).
+void check_step_count(Checker& c, const scene::Scene& s) {
+  const double end = s.time().end_s(), safety = s.time().safety_factor();
+  if (!s.time().has_end_s() || !(std::isfinite(end) && end > 0) || !(safety > 0 && safety <= 1)) return;
+  double stable = kInf;
+  std::string source;
+  bool complete = true;
+  auto take = [&](double dt, const std::string& what) {
+    if (!(dt > 0) || !std::isfinite(dt)) {
+      complete = false;
+      return;
+    }
+    if (dt < stable) stable = dt, source = what;
+  };
+  if (s.solid().has_prescribed_crack()) {
+    take(s.solid().prescribed_crack().stable_dt_s(), "solid.prescribed_crack.stable_dt_s");
+  } else if (s.solid().has_mpm()) {
+    const double dt = mpm_solid_stable_dt(s.solid().mpm());
+    if (std::isnan(dt)) return;  // invalid materials or grid: reported by their own rules
+    if (!(dt > 0) || !std::isfinite(dt)) {
+      c.bad("time.end_s", text(end),
+            "a run of finitely many steps: the MPM solid's stable step cfl h / c_p is " + text(dt) +
+                " s (check the materials' youngs_modulus_pa and density_kg_m3 and cell_size_m)");
+      return;
+    }
+    take(dt, "the MPM solid's stable step cfl h / c_p");
+  } else {
+    return;
+  }
+  if (s.has_fluid()) {
+    if (s.fluid().has_prescribed_pressure())
+      take(s.fluid().prescribed_pressure().stable_dt_s(), "fluid.prescribed_pressure.stable_dt_s");
+    else
+      complete = false;
+  }
+  if (!std::isfinite(stable)) return;
+  const double dt = safety * stable;
+  const double steps = end / dt;
+  if (!std::isfinite(steps) || steps > kMaxRunSteps) {
+    c.bad("time.end_s", text(end),
+          "at most " + text(kMaxRunSteps) + " steps to reach it: " + source + " is " + text(stable) +
+              " s, dt = time.safety_factor x that = " + text(dt) + " s, so the run needs " + text(steps) +
+              " steps (check the moduli, densities and cell size, or shorten end_s)");
+  } else if (complete && dt > end) {
+    c.bad("time.end_s", text(end),
+          "at least one step: " + source + " is " + text(stable) + " s, dt = time.safety_factor x that = " + text(dt) +
+              " s, longer than end_s, so the run would be one step ending at t = " + text(dt) +
+              " s, not at end_s (check the moduli, densities and cell size, or lengthen end_s)");
+  }
+}
+
 }  // namespace
 
 std::vector<SceneProblem> validate(const scene::Scene& s) {
   Checker c;
-  if (s.has_name() && !std::regex_match(s.name(), std::regex("[A-Za-z0-9_.-]+"))) {
-    c.bad("name", "\"" + s.name() + "\"", "letters, digits, '_', '.', '-' (it is used in file names)");
-  }
+  check_name(c, s);
   check_time(c, s);
   check_coupling(c, s.coupling());
   if (!s.has_solid() || s.solid().model_case() == scene::Solid::MODEL_NOT_SET) {
@@ -202,7 +325,29 @@ std::vector<SceneProblem> validate(const scene::Scene& s) {
           "JACOBI or GAUSS_SEIDEL with this solid: the implicit scheme needs solid.mpm (the prescribed crack "
           "reports no face response for the fluid's interface solve)");
   }
-  return c.take();
+  check_step_count(c, s);
+  // A NaN or an infinity anywhere makes every rule that uses it meaningless:
+  // then only those numbers are reported (by the rule of their key if it has
+  // one that speaks of finiteness, else as not finite), and the other rules are
+  // checked once they are finite.
+  Checker finite;
+  check_finite(finite, s, "");
+  auto problems = c.take();
+  const auto not_finite = finite.take();
+  if (not_finite.empty()) return problems;
+  std::set<std::string> keys;
+  for (const auto& p : not_finite) keys.insert(p.key);
+  std::vector<SceneProblem> out;
+  std::set<std::string> reported;
+  for (auto& p : problems) {
+    // The key's own rule wins where it says what is wrong (a finite value in a range).
+    const bool says_finite = p.allowed.find("finite") != std::string::npos;
+    if (keys.count(p.key) && says_finite && reported.insert(p.key).second) out.push_back(std::move(p));
+  }
+  for (const auto& p : not_finite) {
+    if (!reported.count(p.key)) out.push_back(p);
+  }
+  return out;
 }
 
 double output_interval(const scene::Scene& scene) {

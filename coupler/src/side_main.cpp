@@ -13,6 +13,8 @@ void usage(std::ostream& out, const std::string& program, protocol::Role role) {
       << "  --connect ENDPOINT       the coupler's control endpoint (tcp://HOST:PORT, ipc://PATH)\n"
       << "  --out DIR                where this side writes its files (default: the coupler's)\n"
       << "  --advertise-host HOST    tcp: the host name the other side reaches this one at\n"
+      << "  --keys FILE              tcp: the sides' CURVE key file (side.keys from 'hfmpm keygen DIR');\n"
+      << "                           a coupler on tcp admits no side without it (unless --insecure-tcp)\n"
       << "  --welcome-timeout S      seconds to wait for the coupler's answer (default 60)\n"
       << "  --fault KIND@STEP        test hook: exit|crash|hang|freeze|garbage|nan at STEP\n"
       << "  --protocol-version N     test hook: claim protocol version N\n"
@@ -43,6 +45,12 @@ int side_main(int argc, char** argv, protocol::Role role, const std::string& imp
         options.control_endpoint = value();
       } else if (arg == "--out") {
         options.output_dir = value();
+      } else if (arg == "--keys") {
+        try {
+          options.curve = read_side_key_file(value());
+        } catch (const std::runtime_error& e) {
+          throw InputError(e.what());
+        }
       } else if (arg == "--advertise-host") {
         options.advertise_host = value();
       } else if (arg == "--welcome-timeout") {
@@ -56,6 +64,10 @@ int side_main(int argc, char** argv, protocol::Role role, const std::string& imp
       }
     }
     if (options.control_endpoint.empty()) throw InputError("--connect ENDPOINT is required; see --help");
+    if (options.control_endpoint.rfind("tcp://", 0) == 0 && !options.curve) {
+      std::cerr << program << ": note: no --keys: joining over plain tcp; a coupler that requires CURVE (the "
+                << "default on tcp) will not hear this side\n";
+    }
   } catch (const std::exception& e) {
     std::cerr << program << ": " << e.what() << "\n";
     return kSideInput;

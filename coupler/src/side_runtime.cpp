@@ -53,6 +53,10 @@ class SideRuntime {
         peer_(options.role == protocol::SOLID ? "fluid" : "solid") {
     control_.set(zmq::sockopt::linger, kLingerMs);
     control_.set(zmq::sockopt::routing_id, role_);
+    if (options.curve) {
+      make_curve_client(control_, options.curve->server_public, options.curve->client_public,
+                        options.curve->client_secret);
+    }
     control_.connect(options.control_endpoint);
   }
 
@@ -115,7 +119,7 @@ class SideRuntime {
     send(control_, hello_envelope);
     // From now on the coupler hears from this side even during a long setup.
     heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role, heartbeat_step_,
-                                                   waiting_for_peer_);
+                                                   waiting_for_peer_, options_.curve);
 
     const auto deadline = Clock::now() + to_us(options_.welcome_timeout_s);
     while (true) {
@@ -183,6 +187,15 @@ class SideRuntime {
     if (has_peer_) {
       data_.emplace(context_, zmq::socket_type::pair);
       data_->set(zmq::sockopt::linger, kLingerMs);
+      const bool curve = options_.curve && welcome_.data_plane().endpoint().rfind("tcp://", 0) == 0;
+      if (curve && mode == protocol::DataPlane::BIND) {
+        // Only the other side, holding the same key pair, gets through.
+        zap_ = std::make_unique<ZapAuthenticator>(context_, options_.curve->client_public);
+        make_curve_server(*data_, options_.curve->client_secret);
+      } else if (curve) {
+        make_curve_client(*data_, options_.curve->client_public, options_.curve->client_public,
+                          options_.curve->client_secret);
+      }
       if (mode == protocol::DataPlane::BIND) {
         data_->bind(welcome_.data_plane().endpoint());
         std::string host = options_.advertise_host;
@@ -446,6 +459,7 @@ class SideRuntime {
   std::unique_ptr<zmq::context_t> own_context_;
   zmq::context_t& context_;
   zmq::socket_t control_;
+  std::unique_ptr<ZapAuthenticator> zap_;  // before data_: outlives the socket it guards
   std::optional<zmq::socket_t> data_;
   std::string role_, peer_;
   protocol::Welcome welcome_;

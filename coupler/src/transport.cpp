@@ -4,9 +4,7 @@
 
 namespace hfmpm::coupling {
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 void send(zmq::socket_t& socket, const protocol::Envelope& envelope) {
   const std::string bytes = proto::encode(envelope);
@@ -69,6 +67,23 @@ void send_routed(zmq::socket_t& router, const std::string& peer, const protocol:
       !router.send(zmq::buffer(bytes), zmq::send_flags::none)) {
     throw std::runtime_error("could not send a " + std::string(proto::body_name(envelope)) + " message to " + peer);
   }
+}
+
+std::string printable(const std::string& text, std::size_t max) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      static const char* hex = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  if (text.size() > max) out += "...";
+  return out;
 }
 
 std::string advertise(const std::string& bound_endpoint, const std::string& host) {

@@ -28,8 +28,8 @@ inline std::string prescribed_scene(double end_s = 0.2, double interval_s = 0.01
   return replace_once(text, "interval_s: 0.05", "interval_s: " + std::to_string(interval_s));
 }
 
-inline RunResult run_scene(const std::string& scene_text, const std::string& out,
-                           const std::vector<std::string>& extra, double timeout_s = 120) {
+inline RunResult run_scene(const std::string& scene_text, const std::string& out, const std::vector<std::string>& extra,
+                           double timeout_s = 120) {
   const std::string scene = out + "/scene.scene";
   write_file(scene, scene_text);
   std::vector<std::string> argv{bin("hfmpm"), "run", scene, "--out", out, "--quiet"};
@@ -49,6 +49,16 @@ inline void expect_same_history(const Csv& a, const Csv& b) {
       }
     }
   }
+}
+
+// `hfmpm keygen DIR/keys`: the coupler's and the sides' CURVE key files.
+struct KeyFiles {
+  std::string coupler, side;
+};
+inline KeyFiles make_keys(const std::string& dir) {
+  const auto result = run({bin("hfmpm"), "keygen", dir + "/keys"}, 20);
+  if (result.exit_code != 0) throw std::runtime_error("hfmpm keygen failed: " + result.err);
+  return {dir + "/keys/coupler.keys", dir + "/keys/side.keys"};
 }
 
 // Polls a run.json until the coupler has written its bound control endpoint.

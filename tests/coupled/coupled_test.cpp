@@ -84,8 +84,8 @@ TEST(Coupled, IpcRunMatchesTheStandInFormulas) {
 // step n-1; in Gauss-Seidel on the crack of step n. The front (0.9 L) shows it.
 void expect_front_lag(const std::string& scheme, int lag) {
   const auto out = scratch_dir("scheme");
-  const auto result = run_scene(prescribed_scene(), out,
-                                {"--set", "output.exchange_log=true", "--set", "coupling.scheme=" + scheme});
+  const auto result =
+      run_scene(prescribed_scene(), out, {"--set", "output.exchange_log=true", "--set", "coupling.scheme=" + scheme});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const Csv widths = read_csv(out + "/fluid_received.csv");
   const Csv pressures = read_csv(out + "/solid_received.csv");
@@ -141,12 +141,14 @@ TEST(Coupled, TcpCouplerAndSidesStartedByHand) {
   const auto out = scratch_dir("tcp");
   const auto scene = out + "/scene.scene";
   write_file(scene, prescribed_scene());
-  Process coupler({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet"});
+  const auto keys = make_keys(out);
+  Process coupler(
+      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--keys", keys.coupler, "--out", out, "--quiet"});
   const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
   ASSERT_EQ(endpoint.rfind("tcp://127.0.0.1:", 0), 0u) << endpoint;
-  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--out", out + "/solid",
+  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--keys", keys.side, "--out", out + "/solid",
                  "--advertise-host", "127.0.0.1"});
-  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", out + "/fluid"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--keys", keys.side, "--out", out + "/fluid"});
   ASSERT_TRUE(coupler.wait(60)) << coupler.err();
   EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
   ASSERT_TRUE(solid.wait(10));
@@ -155,6 +157,9 @@ TEST(Coupled, TcpCouplerAndSidesStartedByHand) {
   EXPECT_EQ(fluid.exit_code(), 0) << fluid.err();
   const std::string manifest = read_file(out + "/run.json");
   EXPECT_EQ(json_string(manifest, "data_endpoint").rfind("tcp://127.0.0.1:", 0), 0u) << manifest;
+  EXPECT_EQ(json_string(manifest, "tcp_security"), "CURVE");
+  EXPECT_EQ(manifest.find(read_file(keys.side).substr(read_file(keys.side).find("client_secret = ") + 16, 40)),
+            std::string::npos);  // no secret in run.json
   expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
 }
 

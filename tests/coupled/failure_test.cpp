@@ -6,6 +6,7 @@
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <zmq.hpp>
@@ -161,12 +162,15 @@ TEST(Failure, HandStartedSidesExitWhenTheCouplerGoesSilent) {
   const auto out = scratch_dir("silent");
   const std::string scene = out + "/scene.scene";
   write_file(scene, prescribed_scene(100.0, 0.01));
-  std::vector<std::string> argv{bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet"};
+  const auto keys = make_keys(out);
+  std::vector<std::string> argv{bin("hfmpm"), "coupler",    scene,   "--bind", "tcp://127.0.0.1:*",
+                                "--keys",     keys.coupler, "--out", out,      "--quiet"};
   argv.insert(argv.end(), kFastLiveness.begin(), kFastLiveness.end());
   Process coupler(argv);
   const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
-  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--advertise-host", "127.0.0.1"});
-  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint});
+  Process solid(
+      {bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--keys", keys.side, "--advertise-host", "127.0.0.1"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--keys", keys.side});
   for (int i = 0; i < 500 && history_rows(out) < 3; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
@@ -186,16 +190,17 @@ TEST(Failure, NoSideJoinsWithinTheJoinTimeout) {
   const auto out = scratch_dir("nojoin");
   const std::string scene = out + "/scene.scene";
   write_file(scene, prescribed_scene());
-  const auto result = run({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet",
-                           "--set", "coupling.join_timeout_s=1"},
+  const auto result = run({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--insecure-tcp", "--out",
+                           out, "--quiet", "--set", "coupling.join_timeout_s=1"},
                           20);
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.err.find("within coupling.join_timeout_s"), std::string::npos) << result.err;
   EXPECT_NE(result.err.find("solid, fluid"), std::string::npos) << result.err;
 }
 
-// Bytes that are not ZMTP on the coupler's tcp port, and a ZeroMQ peer that is
-// neither side sending garbage: both are refused and the run goes on unchanged.
+// Plain tcp (--insecure-tcp): bytes that are not ZMTP on the coupler's tcp
+// port, and a ZeroMQ peer that is neither side sending garbage: both are
+// refused and the run goes on unchanged.
 TEST(Failure, StrangersOnTheControlPortAreIgnored) {
   const auto reference = scratch_dir("strangers-ref");
   ASSERT_EQ(run_scene(prescribed_scene(), reference, {}).exit_code, 0);
@@ -203,7 +208,8 @@ TEST(Failure, StrangersOnTheControlPortAreIgnored) {
   const auto out = scratch_dir("strangers");
   const std::string scene = out + "/scene.scene";
   write_file(scene, prescribed_scene());
-  Process coupler({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet"});
+  Process coupler(
+      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--insecure-tcp", "--out", out, "--quiet"});
   const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
   ASSERT_FALSE(endpoint.empty());
   const int port = std::stoi(endpoint.substr(endpoint.rfind(':') + 1));
@@ -302,6 +308,72 @@ TEST(Failure, ASecondSignalStopsAtOnce) {
   EXPECT_FALSE(pid_alive(solid));
   EXPECT_FALSE(std::filesystem::exists(ipc_dir));
   EXPECT_GE(read_csv(out + "/history.csv").rows.size(), 1u);
+}
+
+// CURVE (the default on tcp): an impostor fluid that joins first, one with
+// its own key pair (even knowing the coupler's public key) and one with no
+// keys, never reaches the coupler; the real sides join after them and the
+// run is the same as without strangers. The refusal is logged, once a second.
+TEST(Failure, ImpostorsWithoutTheSideKeyCannotJoin) {
+  const auto reference = scratch_dir("impostor-ref");
+  ASSERT_EQ(run_scene(prescribed_scene(), reference, {}).exit_code, 0);
+  const auto out = scratch_dir("impostor");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene());
+  const auto keys = make_keys(out);
+  const auto other = make_keys(out + "/other");
+  // The impostor's file: the real coupler's public key, its own pair.
+  auto value = [](const std::string& file, const std::string& name) {
+    const std::string text = read_file(file);
+    return text.substr(text.find(name + " = ") + name.size() + 3, 40);
+  };
+  const std::string forged = out + "/forged.keys";
+  write_file(forged, "server_public = " + value(keys.side, "server_public") +
+                         "\nclient_public = " + value(other.side, "client_public") +
+                         "\nclient_secret = " + value(other.side, "client_secret") + "\n");
+  chmod(forged.c_str(), 0600);
+  Process coupler(
+      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--keys", keys.coupler, "--out", out, "--quiet"});
+  const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
+  ASSERT_FALSE(endpoint.empty());
+  Process forged_fluid(
+      {bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--keys", forged, "--welcome-timeout", "1.5"});
+  Process plain_fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--welcome-timeout", "1.5"});
+  ASSERT_TRUE(forged_fluid.wait(10));
+  ASSERT_TRUE(plain_fluid.wait(10));
+  EXPECT_NE(forged_fluid.err().find("no answer to Hello"), std::string::npos) << forged_fluid.err();
+  EXPECT_NE(plain_fluid.err().find("no answer to Hello"), std::string::npos) << plain_fluid.err();
+  Process solid(
+      {bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--keys", keys.side, "--advertise-host", "127.0.0.1"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--keys", keys.side});
+  ASSERT_TRUE(coupler.wait(60));
+  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
+  const std::string log = read_file(out + "/coupler.log");
+  EXPECT_NE(log.find("without this run's side key"), std::string::npos) << log;
+  EXPECT_EQ(log.find("ignored a message"), std::string::npos) << log;
+  expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
+}
+
+// Join mode on tcp without keys is refused with the way out named; a key
+// file open to others is refused.
+TEST(Failure, TcpCouplerNeedsKeysOrInsecureTcp) {
+  const auto out = scratch_dir("nokeys");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene());
+  const auto result = run({bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--out", out, "--quiet"}, 20);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("needs --keys FILE"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("--insecure-tcp"), std::string::npos) << result.err;
+  const auto keys = make_keys(out);
+  chmod(keys.coupler.c_str(), 0644);
+  const auto open = run(
+      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--keys", keys.coupler, "--out", out, "--quiet"},
+      20);
+  EXPECT_EQ(open.exit_code, 1);
+  EXPECT_NE(open.err.find("chmod 600"), std::string::npos) << open.err;
+  const auto again = run({bin("hfmpm"), "keygen", out + "/keys"}, 20);
+  EXPECT_NE(again.exit_code, 0);
+  EXPECT_NE(again.err.find("does not overwrite"), std::string::npos) << again.err;
 }
 
 }  // namespace

@@ -37,6 +37,12 @@ struct RunOptions {
   // run to stop. Read before each control round and while waiting for the
   // sides to join; the run then ends "interrupted".
   const std::atomic<int>* stop_request = nullptr;
+  // tcp security (docs/reliability.md, "Who may join"). By default a tcp
+  // control endpoint is CURVE-authenticated: 'run' makes keys for the run and
+  // hands them to the sides it starts; join mode needs the coupler's key file
+  // (hfmpm keygen). insecure_tcp: plain tcp, for sides that cannot do CURVE.
+  std::string keys_file;
+  bool insecure_tcp = false;
 };
 
 struct RunSummary {

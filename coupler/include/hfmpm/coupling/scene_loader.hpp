@@ -43,6 +43,15 @@ void apply_override(scene::Scene& scene, const std::string& assignment);
 // Every rule the scene breaks (empty if valid).
 std::vector<SceneProblem> validate(const scene::Scene& scene);
 
+// Rough memory the MPM solid needs for its grid and particles (bytes, from
+// the solver's per-node and per-particle arrays), and the most a scene may
+// ask for: 3/4 of this machine's physical memory (0 if unknown: no check).
+double mpm_solid_memory_bytes(const scene::MpmSolid& m);
+double memory_limit_bytes();
+
+// Most steps a run may need to reach time.end_s (validation and the coupler).
+inline constexpr double kMaxRunSteps = 1e9;
+
 // Effective values used by the coupler.
 double output_interval(const scene::Scene& scene);
 

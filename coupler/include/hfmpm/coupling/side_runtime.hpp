@@ -7,10 +7,12 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 #include <zmq.hpp>
 
+#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/exchange.hpp"
 #include "hfmpm/proto/envelope.hpp"
 #include "hfmpm/scene.pb.h"
@@ -62,6 +64,10 @@ struct SideOptions {
   zmq::context_t* context = nullptr;                         // shared context (in-process mode); own one if null
   std::uint32_t protocol_version = proto::kProtocolVersion;  // tests claim others
   Fault fault;
+  // tcp with CURVE (--keys FILE, the sides' key file): the control and
+  // heartbeat sockets authenticate to the coupler, and the data plane between
+  // the sides is a CURVE server/client pair admitting only this key.
+  std::optional<CurveKeys> curve;
 };
 
 // Exit codes of a side.

@@ -43,4 +43,9 @@ std::string advertise(const std::string& bound_endpoint, const std::string& host
 // The host part of a tcp endpoint, "" otherwise.
 std::string tcp_host(const std::string& endpoint);
 
+// `text` fit for a log line: at most `max` characters, anything outside
+// printable ASCII as \xNN (a peer's name cannot forge lines or reach the
+// terminal as escape sequences).
+std::string printable(const std::string& text, std::size_t max = 64);
+
 }  // namespace hfmpm::coupling
