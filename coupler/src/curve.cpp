@@ -169,8 +169,7 @@ ZapAuthenticator::ZapAuthenticator(zmq::context_t& context, const std::string& a
   socket->bind("inproc://zeromq.zap.01");
   const std::string allowed = z85_to_binary(allowed_public_key);
   thread_ = std::thread([this, socket, allowed, refused = std::move(refused)] {
-    using Clock = std::chrono::steady_clock;
-    Clock::time_point last_told{};
+    std::chrono::steady_clock::time_point last_told{};
     std::uint64_t untold = 0;
     std::string last_address;
     while (!stop_.load()) {
@@ -199,7 +198,7 @@ ZapAuthenticator::ZapAuthenticator(zmq::context_t& context, const std::string& a
           ++refused_;
           ++untold;
           last_address = request.size() > 3 ? request[3].to_string() : "?";
-          const auto now = Clock::now();
+          const auto now = std::chrono::steady_clock::now();
           if (refused && now - last_told > std::chrono::seconds(1)) {
             refused("refused " + std::to_string(untold) + " connection" + (untold == 1 ? "" : "s") +
                     " without this run's side key (the last from " + printable(last_address) + ")");
