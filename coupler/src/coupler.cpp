@@ -163,6 +163,8 @@ void Coupler::prepare() {
 
   router_.set(zmq::sockopt::linger, kLingerMs);
   router_.set(zmq::sockopt::router_mandatory, 1);
+  router_.set(zmq::sockopt::maxmsgsize, kCouplerMaxMessageBytes);
+  router_.set(zmq::sockopt::handshake_ivl, kHandshakeMs);
   const auto transport = scene_.coupling().transport();
   std::string bind = options_.bind_endpoint;
   if (bind.empty()) {

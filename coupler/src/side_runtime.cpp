@@ -53,6 +53,7 @@ class SideRuntime {
         peer_(options.role == protocol::SOLID ? "fluid" : "solid") {
     control_.set(zmq::sockopt::linger, kLingerMs);
     control_.set(zmq::sockopt::routing_id, role_);
+    control_.set(zmq::sockopt::maxmsgsize, kSideControlMaxMessageBytes);
     if (options.curve) {
       make_curve_client(control_, options.curve->server_public, options.curve->client_public,
                         options.curve->client_secret);
@@ -187,6 +188,8 @@ class SideRuntime {
     if (has_peer_) {
       data_.emplace(context_, zmq::socket_type::pair);
       data_->set(zmq::sockopt::linger, kLingerMs);
+      data_->set(zmq::sockopt::maxmsgsize, data_plane_message_limit(welcome_.scene()));
+      data_->set(zmq::sockopt::handshake_ivl, kHandshakeMs);
       const bool curve = options_.curve && welcome_.data_plane().endpoint().rfind("tcp://", 0) == 0;
       if (curve && mode == protocol::DataPlane::BIND) {
         // Only the other side, holding the same key pair, gets through.

@@ -1,5 +1,6 @@
 #include "hfmpm/coupling/transport.hpp"
 
+#include <algorithm>
 #include <vector>
 
 namespace hfmpm::coupling {
@@ -67,6 +68,18 @@ void send_routed(zmq::socket_t& router, const std::string& peer, const protocol:
       !router.send(zmq::buffer(bytes), zmq::send_flags::none)) {
     throw std::runtime_error("could not send a " + std::string(proto::body_name(envelope)) + " message to " + peer);
   }
+}
+
+std::int64_t data_plane_message_limit(const scene::Scene& scene) {
+  constexpr std::int64_t base = std::int64_t{16} << 20;
+  if (!scene.solid().has_mpm()) return std::int64_t{256} << 20;
+  const auto& mpm = scene.solid().mpm();
+  const auto& grid = mpm.grid();
+  const double h = mpm.cell_size_m();
+  const double cells = h > 0 ? (grid.x_max_m() - grid.x_min_m() + grid.y_max_m() - grid.y_min_m()) / h : 0;
+  const double particles = 8 * std::max(1.0, cells) * std::max(1, mpm.cracks_size());
+  const double bytes = static_cast<double>(base) + 2048 * particles;
+  return bytes < 1e15 ? static_cast<std::int64_t>(bytes) : std::int64_t{1} << 50;
 }
 
 std::string printable(const std::string& text, std::size_t max) {

@@ -376,5 +376,34 @@ TEST(Failure, TcpCouplerNeedsKeysOrInsecureTcp) {
   EXPECT_NE(again.err.find("does not overwrite"), std::string::npos) << again.err;
 }
 
+// Plain tcp: a stranger that takes a side's name ("fluid") and sends a frame
+// above the coupler's message limit (4 MiB) is disconnected by ZeroMQ before
+// the frame is kept or delivered; the run goes on and is unchanged.
+TEST(Failure, OversizedFrameFromAStrangerIsDropped) {
+  const auto reference = scratch_dir("oversized-ref");
+  ASSERT_EQ(run_scene(prescribed_scene(), reference, {}).exit_code, 0);
+  const auto out = scratch_dir("oversized");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene());
+  Process coupler(
+      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--insecure-tcp", "--out", out, "--quiet"});
+  const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
+  ASSERT_FALSE(endpoint.empty());
+  zmq::context_t context;
+  zmq::socket_t stranger(context, zmq::socket_type::dealer);
+  stranger.set(zmq::sockopt::linger, 0);
+  stranger.set(zmq::sockopt::routing_id, "fluid");
+  stranger.connect(endpoint);
+  const std::string big(std::size_t{32} << 20, '\x01');
+  stranger.send(zmq::buffer(big), zmq::send_flags::none);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  stranger.close();
+  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--out", out, "--advertise-host", "127.0.0.1"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", out});
+  ASSERT_TRUE(coupler.wait(60));
+  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
+  expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
+}
+
 }  // namespace
 }  // namespace hfmpm::test

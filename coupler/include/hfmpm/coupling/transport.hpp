@@ -3,12 +3,14 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <zmq.hpp>
 
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {
 
@@ -18,6 +20,23 @@ double seconds_since(Clock::time_point start);
 
 // Sockets never block process exit for more than this (ms) on unsent messages.
 inline constexpr int kLingerMs = 500;
+
+// Largest message a socket accepts (ZMQ_MAXMSGSIZE; a peer that sends more
+// is disconnected before the bytes are kept). The coupler hears only small
+// control messages; a side's control socket receives Welcome with the scene
+// (scene files are at most 16 MiB of text); the data plane carries the crack
+// and fluid state, bounded from the scene (data_plane_message_limit).
+inline constexpr std::int64_t kCouplerMaxMessageBytes = std::int64_t{4} << 20;
+inline constexpr std::int64_t kSideControlMaxMessageBytes = std::int64_t{64} << 20;
+// Data-plane limit for a scene: 16 MiB plus 2 KiB for every crack particle
+// the grid can hold along its cracks (8 per cell over the grid's width plus
+// height, per crack), or 256 MiB without an MPM grid.
+std::int64_t data_plane_message_limit(const scene::Scene& scene);
+
+// How long a connection may take to complete the ZeroMQ handshake (and, on
+// tcp, CURVE) before it is dropped: a peer that connects and says nothing
+// holds a descriptor for at most this long.
+inline constexpr int kHandshakeMs = 5000;
 
 void send(zmq::socket_t& socket, const protocol::Envelope& envelope);
 
