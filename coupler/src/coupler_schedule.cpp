@@ -52,6 +52,7 @@ protocol::Envelope Coupler::welcome_for(protocol::DataPlane::Mode mode, const st
   protocol::Envelope envelope;
   auto* welcome = envelope.mutable_welcome();
   welcome->set_protocol_version(proto::kProtocolVersion);
+  welcome->set_scene_schema_version(proto::kSceneSchemaVersion);
   welcome->set_run_id(run_id_);
   *welcome->mutable_scene() = scene_;
   welcome->set_output_dir(output_dir_);
@@ -73,6 +74,12 @@ void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelop
     if (hello.protocol_version() != proto::kProtocolVersion) {
       reject(side, who + " speaks protocol version " + std::to_string(hello.protocol_version()) +
                        "; this coupler speaks version " + std::to_string(proto::kProtocolVersion));
+    }
+    if (hello.scene_schema_version() != proto::kSceneSchemaVersion) {
+      reject(side, who + " was built with scene schema version " + std::to_string(hello.scene_schema_version()) +
+                       (hello.scene_schema_version() == 0 ? " (before scenes were versioned)" : "") +
+                       "; this coupler's scenes are version " + std::to_string(proto::kSceneSchemaVersion) +
+                       ": build the side from the same scene.proto (docs/protocol.md, \"Versions\")");
     }
     side.joined = true;
     side.implementation = hello.implementation() + " " + hello.implementation_version();
@@ -101,6 +108,7 @@ void Coupler::reject(Side& side, const std::string& reason) {
   protocol::Envelope envelope;
   envelope.mutable_reject()->set_reason(reason);
   envelope.mutable_reject()->set_coupler_protocol_version(proto::kProtocolVersion);
+  envelope.mutable_reject()->set_coupler_scene_schema_version(proto::kSceneSchemaVersion);
   try {
     send_routed(router_, side.name, envelope);
   } catch (const std::exception&) {

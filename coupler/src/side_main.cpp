@@ -18,6 +18,7 @@ void usage(std::ostream& out, const std::string& program, protocol::Role role) {
       << "  --welcome-timeout S      seconds to wait for the coupler's answer (default 60)\n"
       << "  --fault KIND@STEP        test hook: exit|crash|hang|freeze|garbage|nan at STEP\n"
       << "  --protocol-version N     test hook: claim protocol version N\n"
+      << "  --scene-schema-version N test hook: claim scene schema version N (0: an older side)\n"
       << "  --help                   this text\n";
 }
 
@@ -59,6 +60,8 @@ int side_main(int argc, char** argv, protocol::Role role, const std::string& imp
         options.fault = Fault::parse(value());
       } else if (arg == "--protocol-version") {
         options.protocol_version = static_cast<std::uint32_t>(std::stoul(value()));
+      } else if (arg == "--scene-schema-version") {
+        options.scene_schema_version = static_cast<std::uint32_t>(std::stoul(value()));
       } else {
         throw InputError("unknown option '" + arg + "'; see --help");
       }

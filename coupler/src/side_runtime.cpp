@@ -112,6 +112,7 @@ class SideRuntime {
     auto* hello = hello_envelope.mutable_hello();
     hello->set_role(options_.role);
     hello->set_protocol_version(options_.protocol_version);
+    hello->set_scene_schema_version(options_.scene_schema_version);
     hello->set_implementation(options_.implementation);
     hello->set_implementation_version(options_.implementation_version);
     for (const auto& c : options_.capabilities) hello->add_capabilities(c);
@@ -142,6 +143,11 @@ class SideRuntime {
         throw proto::ProtocolError("the coupler's Welcome says protocol version " +
                                    std::to_string(welcome_.protocol_version()) + "; this side speaks version " +
                                    std::to_string(options_.protocol_version));
+      }
+      if (welcome_.scene_schema_version() != options_.scene_schema_version) {
+        throw proto::ProtocolError("the coupler's Welcome carries a scene of schema version " +
+                                   std::to_string(welcome_.scene_schema_version()) + "; this side was built with " +
+                                   std::to_string(options_.scene_schema_version));
       }
       return;
     }

@@ -183,9 +183,7 @@ std::string Session::waited(double timeout_s) {
 }
 
 // A program that has ended gets a moment for its last messages to arrive, then waits stop.
-bool Session::gone() {
-  return ended() && Clock::now() - *ended_at_ > std::chrono::milliseconds(300);
-}
+bool Session::gone() { return ended() && Clock::now() - *ended_at_ > std::chrono::milliseconds(300); }
 
 std::optional<protocol::Envelope> Session::poll_control(double timeout_s) {
   if (!pending_.empty()) {
@@ -256,6 +254,10 @@ protocol::Hello Session::expect_hello(std::uint32_t version) {
     fail("Hello.protocol_version is " + std::to_string(hello_.protocol_version()) + " where " +
          std::to_string(version) + " was due");
   }
+  if (hello_.scene_schema_version() != proto::kSceneSchemaVersion) {
+    fail("Hello.scene_schema_version is " + std::to_string(hello_.scene_schema_version()) + " where " +
+         std::to_string(proto::kSceneSchemaVersion) + " (the scene.proto this harness was built with) was due");
+  }
   if (hello_.implementation().empty()) fail("Hello.implementation is empty; it names the program");
   if (hello_.implementation_version().empty()) fail("Hello.implementation_version is empty");
   return hello_;
@@ -265,6 +267,7 @@ void Session::send_welcome() {
   protocol::Envelope envelope;
   auto* welcome = envelope.mutable_welcome();
   welcome->set_protocol_version(proto::kProtocolVersion);
+  welcome->set_scene_schema_version(proto::kSceneSchemaVersion);
   welcome->set_run_id("conformance-" + context_.check);
   *welcome->mutable_scene() = scene_;
   welcome->set_output_dir(dir_ + "/out");
@@ -294,8 +297,8 @@ void Session::connect_to_listening() {
   }
   const std::string host = coupling::tcp_host(endpoint);
   const std::string port = endpoint.substr(endpoint.rfind(':') + 1);
-  if (endpoint.rfind("tcp://", 0) == 0 && (host.empty() || host == "*" || host == "0.0.0.0" || port == "*" ||
-                                           port == "0")) {
+  if (endpoint.rfind("tcp://", 0) == 0 &&
+      (host.empty() || host == "*" || host == "0.0.0.0" || port == "*" || port == "0")) {
     fail(where + " is a wildcard, not an address a peer can connect to");
   }
   data_endpoint_ = endpoint;

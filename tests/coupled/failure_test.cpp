@@ -101,6 +101,16 @@ TEST(Failure, FluidWithAnotherProtocolVersionIsRejected) {
   expect_clean_failure(run, "fluid", "speaks protocol version 2; this coupler speaks version 1", 0);
 }
 
+// A side built before scene schema versions (it sends 0) or with another
+// scene.proto is refused at the handshake with the versions named.
+TEST(Failure, SideWithAnotherSceneSchemaIsRejected) {
+  const auto older = run_with("solid", {"--scene-schema-version", "0"});
+  expect_clean_failure(older, "solid", "was built with scene schema version 0 (before scenes were versioned)", 0);
+  const auto newer = run_with("fluid", {"--scene-schema-version", "99"});
+  expect_clean_failure(newer, "fluid", "was built with scene schema version 99; this coupler's scenes are version 1",
+                       0);
+}
+
 TEST(Failure, GarbageFromASideIsRejected) {
   const auto run = run_with("fluid", {"--fault", "garbage@30"});
   expect_clean_failure(run, "fluid", "malformed message from the fluid side");

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
 #include <string>
 
@@ -257,3 +258,22 @@ TEST(Names, BodyAndRoleNames) {
 }
 
 }  // namespace
+
+// The scene schema's fingerprint (FNV-1a of the descriptor of scene.proto, as
+// protoc parsed it, comments excluded; the text is that of Debian 12's
+// protobuf 3.21, so another protobuf may change it) for each SceneSchema version. A change
+// to scene.proto changes the fingerprint: bump SCENE_SCHEMA_CURRENT in
+// protocol.proto and add the new line here (docs/protocol.md, section 3).
+TEST(Versions, SceneSchemaIsBumpedWithTheSchema) {
+  const std::string schema = hfmpm::scene::Scene::descriptor()->file()->DebugString();
+  std::uint64_t hash = 1469598103934665603ull;
+  for (unsigned char c : schema) hash = (hash ^ c) * 1099511628211ull;
+  const std::map<std::uint32_t, std::uint64_t> fingerprints{
+      {1, 9993337185708650126ull},
+  };
+  ASSERT_TRUE(fingerprints.count(hfmpm::proto::kSceneSchemaVersion))
+      << "no fingerprint recorded for scene schema version " << hfmpm::proto::kSceneSchemaVersion;
+  EXPECT_EQ(fingerprints.at(hfmpm::proto::kSceneSchemaVersion), hash)
+      << "scene.proto changed (fingerprint " << hash << "ull) but SCENE_SCHEMA_CURRENT is still "
+      << hfmpm::proto::kSceneSchemaVersion << ": bump it in protocol.proto and record the new fingerprint here";
+}

@@ -63,6 +63,7 @@ struct SideOptions {
   double welcome_timeout_s = 60;                             // the coupler must answer Hello within this
   zmq::context_t* context = nullptr;                         // shared context (in-process mode); own one if null
   std::uint32_t protocol_version = proto::kProtocolVersion;  // tests claim others
+  std::uint32_t scene_schema_version = proto::kSceneSchemaVersion;  // tests claim others
   Fault fault;
   // tcp with CURVE (--keys FILE, the sides' key file): the control and
   // heartbeat sockets authenticate to the coupler, and the data plane between

@@ -12,6 +12,7 @@
 namespace hfmpm::proto {
 
 inline constexpr std::uint32_t kProtocolVersion = protocol::CURRENT;
+inline constexpr std::uint32_t kSceneSchemaVersion = protocol::SCENE_SCHEMA_CURRENT;
 
 // A message that breaks the protocol: malformed, unexpected, or inconsistent.
 class ProtocolError : public std::runtime_error {
