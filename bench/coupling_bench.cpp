@@ -91,7 +91,9 @@ coupling::RunSummary run_case(const Case& c, int steps, const std::string& scene
       "solid.prescribed_crack.spacing_m=" + std::to_string(spacing),
       "time.end_s=" + std::to_string(steps * 5e-5),
       "output.interval_s=" + std::to_string(steps * 5e-5),
-      "coupling.transport=" + std::string(c.transport == "inproc" ? "INPROC" : c.transport == "ipc" ? "IPC" : "TCP"),
+      "coupling.transport=" + std::string(c.transport == "inproc" ? "INPROC"
+                                          : c.transport == "ipc"  ? "IPC"
+                                                                  : "TCP"),
       "coupling.exchange_interval=" + std::to_string(c.exchange_interval),
       "coupling.control_interval=" + std::to_string(c.control_interval),
   };
@@ -110,8 +112,10 @@ int main(int argc, char** argv) {
   bool quick = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--steps" && i + 1 < argc) steps = std::stoi(argv[++i]);
-    else if (arg == "--quick") quick = true;
+    if (arg == "--steps" && i + 1 < argc)
+      steps = std::stoi(argv[++i]);
+    else if (arg == "--quick")
+      quick = true;
     else {
       std::cerr << "usage: hfmpm-bench-coupling [--steps N] [--quick]\n";
       return 2;
@@ -146,12 +150,11 @@ int main(int argc, char** argv) {
       return 1;
     }
     const double per_exchange = summary.overhead_per_step_us() * c.exchange_interval;
-    const std::size_t ti = static_cast<std::size_t>(
-        std::find(transports.begin(), transports.end(), c.transport) - transports.begin());
-    std::printf("| %d | %s | %d | %d | %.0f | %.1f | %.2f |\n", c.particles, c.transport.c_str(),
-                c.exchange_interval, c.control_interval,
-                static_cast<double>(summary.steps) / summary.stepping_wall_s, summary.overhead_per_step_us(),
-                per_exchange / rtt[ti]);
+    const std::size_t ti =
+        static_cast<std::size_t>(std::find(transports.begin(), transports.end(), c.transport) - transports.begin());
+    std::printf("| %d | %s | %d | %d | %.0f | %.1f | %.2f |\n", c.particles, c.transport.c_str(), c.exchange_interval,
+                c.control_interval, static_cast<double>(summary.steps) / summary.stepping_wall_s,
+                summary.overhead_per_step_us(), per_exchange / rtt[ti]);
     std::fflush(stdout);
   }
   return 0;

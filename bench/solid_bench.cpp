@@ -29,7 +29,8 @@ SolidConfig block(int cells, int threads) {
   r.initial_stress = Voigt(-1e6, -1e6, 0, -0.5e6);
   c.regions = {r};
   c.constraints = {{Constraint::Kind::PlaneX, 0.0}, {Constraint::Kind::PlaneY, 0.0}};
-  c.tractions = {{Edge::Right, TimeFunction::constant(-1e6)}, {Edge::Top, TimeFunction::table({0.0, 1.0}, {-1e6, -2e6})}};
+  c.tractions = {{Edge::Right, TimeFunction::constant(-1e6)},
+                 {Edge::Top, TimeFunction::table({0.0, 1.0}, {-1e6, -2e6})}};
   c.damping.grid_alpha = 100;
   c.threads = threads;
   return c;
@@ -93,11 +94,14 @@ int main(int argc, char** argv) {
   int cells = 200, steps = 200;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i];
-    if (arg == "--cells") cells = std::stoi(argv[i + 1]);
-    else if (arg == "--steps") steps = std::stoi(argv[i + 1]);
+    if (arg == "--cells")
+      cells = std::stoi(argv[i + 1]);
+    else if (arg == "--steps")
+      steps = std::stoi(argv[i + 1]);
   }
-  std::printf("| case | particles | threads | steps | wall (s) | particle-steps/s | bytes/particle |\n"
-              "|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| case | particles | threads | steps | wall (s) | particle-steps/s | bytes/particle |\n"
+      "|---|---|---|---|---|---|---|\n");
   run("uncracked block", block, cells, steps);
   run("Sneddon, cracked (h = a/20)", cracked, 20, steps);
   return 0;

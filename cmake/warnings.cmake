@@ -12,6 +12,11 @@ if(HFMPM_SANITIZE)
   target_link_options(hfmpm_sanitize INTERFACE -fsanitize=address,undefined)
 endif()
 
+option(HFMPM_WERROR "Treat compiler warnings as errors (CI: tools/bootstrap.sh test)" OFF)
+if(HFMPM_WERROR)
+  target_compile_options(hfmpm_warnings INTERFACE -Werror)
+endif()
+
 # hfmpm_options: warnings + sanitizers, for project code (not generated code).
 add_library(hfmpm_options INTERFACE)
 target_link_libraries(hfmpm_options INTERFACE hfmpm_warnings hfmpm_sanitize)

@@ -13,6 +13,8 @@ case "$mode" in run|test|build) ;; *) echo "usage: $0 run|test|build" >&2; exit 
 packages=(build-essential cmake pkg-config libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
           libeigen3-dev libhdf5-dev libgtest-dev libgmock-dev python3
           python3-numpy python3-matplotlib python3-h5py)  # the last three: tools/kgd_plot.py
+# The test mode also checks format and lint (tools/lint.sh).
+[ "$mode" = test ] && packages+=(clang-format clang-tidy)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -25,7 +27,9 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 jobs=$(nproc)
-cmake --preset release >/dev/null
+# The test mode builds with -Werror: a warning fails CI (other modes leave the
+# cached choice alone, so switching modes does not rebuild everything).
+if [ "$mode" = test ]; then cmake --preset release -DHFMPM_WERROR=ON >/dev/null; else cmake --preset release >/dev/null; fi
 cmake --build --preset release -j "$jobs"
 
 case "$mode" in
@@ -39,6 +43,7 @@ case "$mode" in
     echo "bootstrap: results are in $out (history.csv, run.json, solid.h5, fluid.h5, kgd.png, logs)"
     ;;
   test)
+    bash tools/lint.sh
     ctest --preset release -j "$jobs"
     ;;
   build) ;;

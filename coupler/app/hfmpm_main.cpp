@@ -129,22 +129,31 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       if (out.empty()) {
         throw UsageError("--out needs a directory; an empty one is not allowed (omit --out for hfmpm-out/SCENE_NAME)");
       }
-    }
-    else if (arg == "--set") overrides.push_back(value());
-    else if (arg == "--bind") bind = value();
-    else if (arg == "--quiet") options.progress = false;
-    else if (arg == "--keys") options.keys_file = value();
-    else if (arg == "--insecure-tcp") options.insecure_tcp = true;
-    else if (arg == "--solid-program") options.solid_program = value();
-    else if (arg == "--fluid-program") options.fluid_program = value();
+    } else if (arg == "--set")
+      overrides.push_back(value());
+    else if (arg == "--bind")
+      bind = value();
+    else if (arg == "--quiet")
+      options.progress = false;
+    else if (arg == "--keys")
+      options.keys_file = value();
+    else if (arg == "--insecure-tcp")
+      options.insecure_tcp = true;
+    else if (arg == "--solid-program")
+      options.solid_program = value();
+    else if (arg == "--fluid-program")
+      options.fluid_program = value();
     else if (arg == "--transport") {
       static const std::map<std::string, std::string> names{{"ipc", "IPC"}, {"tcp", "TCP"}, {"inproc", "INPROC"}};
       const std::string t = value();
       if (!names.count(t)) throw UsageError("--transport " + t + ": allowed: ipc, tcp, inproc");
       overrides.push_back("coupling.transport=" + names.at(t));
-    } else if (!arg.empty() && arg[0] == '-') throw UsageError("unknown option '" + arg + "'");
-    else if (scene_path.empty()) scene_path = arg;
-    else throw UsageError("more than one scene given ('" + scene_path + "' and '" + arg + "')");
+    } else if (!arg.empty() && arg[0] == '-')
+      throw UsageError("unknown option '" + arg + "'");
+    else if (scene_path.empty())
+      scene_path = arg;
+    else
+      throw UsageError("more than one scene given ('" + scene_path + "' and '" + arg + "')");
   }
   if (scene_path.empty()) throw UsageError("no scene file given");
   const scene::Scene scene = coupling::load_scene(scene_path, overrides);
@@ -167,8 +176,9 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     options.launch = false;
     options.bind_endpoint = bind;
     if (!options.solid_program.empty() || !options.fluid_program.empty()) {
-      throw UsageError("--solid-program and --fluid-program are for 'hfmpm run'; with 'hfmpm coupler' you start "
-                       "the sides yourself");
+      throw UsageError(
+          "--solid-program and --fluid-program are for 'hfmpm run'; with 'hfmpm coupler' you start "
+          "the sides yourself");
     }
   } else if (!bind.empty()) {
     throw UsageError("--bind is for 'hfmpm coupler'; 'hfmpm run' chooses its own endpoints");

@@ -193,8 +193,9 @@ void Coupler::prepare() {
       } else if (options_.launch) {
         keys = generate_curve_keys();  // this run's own
       } else {
-        throw RunFailure{"a coupler on tcp needs --keys FILE (the coupler.keys that 'hfmpm keygen DIR' writes; "
-                         "the sides take side.keys), or --insecure-tcp for plain tcp"};
+        throw RunFailure{
+            "a coupler on tcp needs --keys FILE (the coupler.keys that 'hfmpm keygen DIR' writes; "
+            "the sides take side.keys), or --insecure-tcp for plain tcp"};
       }
       if (options_.launch) {
         char pattern[] = "/tmp/hfmpm-keys-XXXXXX";  // 0700

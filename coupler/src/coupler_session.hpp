@@ -151,9 +151,9 @@ class Coupler {
   std::unique_ptr<zmq::context_t> context_ = std::make_unique<zmq::context_t>(1);
   std::unique_ptr<ZapAuthenticator> zap_;  // tcp with CURVE; before router_: outlives it
   std::mutex refusals_mutex_;
-  std::string refusals_;  // told by the ZAP thread, logged by housekeeping()
-  std::string keys_dir_;  // the sides' key file of a launched tcp run (0700, removed at the end)
-  std::string side_keys_;  // that file, passed to the sides with --keys
+  std::string refusals_;         // told by the ZAP thread, logged by housekeeping()
+  std::string keys_dir_;         // the sides' key file of a launched tcp run (0700, removed at the end)
+  std::string side_keys_;        // that file, passed to the sides with --keys
   std::uint64_t strangers_ = 0;  // messages from peers that are not a side (plain tcp)
   Clock::time_point last_stranger_log_{};
   zmq::socket_t router_;

@@ -60,7 +60,7 @@ std::map<std::string, std::string> read_key_file(const std::string& path) {
     const auto first = line.find_first_not_of(" \t\r");
     if (first == std::string::npos || line[first] == '#') continue;
     const auto equals = line.find('=');
-    auto trim = [](std::string s) {
+    auto trim = [](const std::string& s) {
       const auto a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
       return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
     };

@@ -9,12 +9,18 @@ Fault Fault::parse(const std::string& text) {
   const auto at = text.find('@');
   const std::string kind = text.substr(0, at);
   Fault fault;
-  if (kind == "exit") fault.kind = Kind::Exit;
-  else if (kind == "crash") fault.kind = Kind::Crash;
-  else if (kind == "hang") fault.kind = Kind::Hang;
-  else if (kind == "freeze") fault.kind = Kind::Freeze;
-  else if (kind == "garbage") fault.kind = Kind::Garbage;
-  else if (kind == "nan") fault.kind = Kind::NaN;
+  if (kind == "exit")
+    fault.kind = Kind::Exit;
+  else if (kind == "crash")
+    fault.kind = Kind::Crash;
+  else if (kind == "hang")
+    fault.kind = Kind::Hang;
+  else if (kind == "freeze")
+    fault.kind = Kind::Freeze;
+  else if (kind == "garbage")
+    fault.kind = Kind::Garbage;
+  else if (kind == "nan")
+    fault.kind = Kind::NaN;
   else {
     throw InputError("--fault '" + text + "': unknown kind '" + kind +
                      "'; allowed: exit, crash, hang, freeze, garbage, nan, as KIND@STEP");

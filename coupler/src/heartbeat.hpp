@@ -26,7 +26,7 @@ class HeartbeatThread {
  public:
   HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role,
                   const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting,
-                  std::optional<CurveKeys> curve)
+                  const std::optional<CurveKeys>& curve)
       : thread_([this, &context, endpoint, role, &step, &waiting, curve] {
           zmq::socket_t socket(context, zmq::socket_type::dealer);
           socket.set(zmq::sockopt::linger, 0);

@@ -36,12 +36,8 @@ class Checker {
       bad(key, text(v), allowed);
     }
   }
-  void positive(const std::string& key, double v, const std::string& unit) {
-    range(key, v, 0, kInf, true, unit);
-  }
-  void non_negative(const std::string& key, double v, const std::string& unit) {
-    range(key, v, 0, kInf, false, unit);
-  }
+  void positive(const std::string& key, double v, const std::string& unit) { range(key, v, 0, kInf, true, unit); }
+  void non_negative(const std::string& key, double v, const std::string& unit) { range(key, v, 0, kInf, false, unit); }
   std::vector<SceneProblem> take() { return std::move(problems_); }
 
  private:

@@ -129,7 +129,8 @@ int line_of(const pb::TextFormat::ParseInfoTree* tree, const pb::Descriptor* typ
   return line;
 }
 
-std::string describe(const SceneProblem& p, const std::string& name, int line, const std::set<std::string>& overridden) {
+std::string describe(const SceneProblem& p, const std::string& name, int line,
+                     const std::set<std::string>& overridden) {
   std::string where = name;
   for (const auto& key : overridden) {
     if (p.key == key || p.key.rfind(key + ".", 0) == 0 || p.key.rfind(key + "[", 0) == 0) {
@@ -202,7 +203,8 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
     pb::TextFormat::Parser parser;
     Collector collector("--set " + key);
     parser.RecordErrorsTo(&collector);
-    const std::string separator = field->type() == pb::FieldDescriptor::TYPE_MESSAGE && value.front() == '{' ? " " : ": ";
+    const std::string separator =
+        field->type() == pb::FieldDescriptor::TYPE_MESSAGE && value.front() == '{' ? " " : ": ";
     if (!parser.MergeFromString(field->name() + separator + value, message)) {
       throw SceneError({"--set " + key + "=" + assignment.substr(equals + 1) + ": not a valid " +
                         (field->type() == pb::FieldDescriptor::TYPE_MESSAGE ? field->message_type()->name()
@@ -243,7 +245,8 @@ scene::Scene parse_scene(const std::string& file_text, const std::string& name,
   const auto problems = validate(scene);
   if (!problems.empty()) {
     std::vector<std::string> lines;
-    for (const auto& p : problems) lines.push_back(describe(p, name, line_of(&tree, scene.GetDescriptor(), p.key), overridden));
+    for (const auto& p : problems)
+      lines.push_back(describe(p, name, line_of(&tree, scene.GetDescriptor(), p.key), overridden));
     throw SceneError(lines);
   }
   return scene;

@@ -83,7 +83,8 @@ void check_time(Checker& c, const scene::Scene& s) {
   if (s.time().max_steps() == 0) c.bad("time.max_steps", "0", "an integer >= 1");
   const double end = s.time().end_s();
   const bool end_valid = s.time().has_end_s() && std::isfinite(end) && end > 0;
-  c.range("output.interval_s", s.output().interval_s(), 0, end_valid ? end : kInf, false, "s, 0 for end_s / 100");
+  const double upper = end_valid ? end : kInf;  // NOLINT(bugprone-narrowing-conversions): clang-tidy 14 misreads inf
+  c.range("output.interval_s", s.output().interval_s(), 0, upper, false, "s, 0 for end_s / 100");
 }
 
 void check_coupling(Checker& c, const scene::Coupling& k) {

@@ -12,8 +12,8 @@ namespace {
 
 // What the fluid needs to know about each crack of the solid in the scene.
 struct SceneCrack {
-  bool mouth = false;    // the first crack particle is a mouth (not a tip)
-  double length = 0;     // m, initial length along the crack
+  bool mouth = false;  // the first crack particle is a mouth (not a tip)
+  double length = 0;   // m, initial length along the crack
 };
 
 std::vector<SceneCrack> scene_cracks(const scene::Solid& solid) {
@@ -48,7 +48,8 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   c.range(key + "flip_fraction", f.flip_fraction(), 0, 1, false, "0 = PIC, 1 = FLIP");
   c.positive(key + "min_width_m", f.min_width_m(), "m");
   c.non_negative(key + "virtual_opening_m", f.virtual_opening_m(), "m");
-  if (f.lag() == scene::MpmFluid::LAG_UNSPECIFIED) c.bad(key + "lag", "LAG_UNSPECIFIED", "ZERO_PRESSURE, FRONT_PRESSURE or FIXED_PRESSURE");
+  if (f.lag() == scene::MpmFluid::LAG_UNSPECIFIED)
+    c.bad(key + "lag", "LAG_UNSPECIFIED", "ZERO_PRESSURE, FRONT_PRESSURE or FIXED_PRESSURE");
   c.non_negative(key + "lag_pressure_pa", f.lag_pressure_pa(), "Pa");
   if (f.max_substeps() < 1 || f.max_substeps() > 100000) {
     c.bad(key + "max_substeps", std::to_string(f.max_substeps()), "1 to 100000 fluid steps per coupled step");
@@ -58,15 +59,20 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
     c.missing(key + "inlet", "an inlet: inlet { flow_rate_m2_s { .. } } or inlet { pressure_pa { .. } }");
   } else {
     const auto& in = f.inlet();
-    if (in.has_flow_rate_m2_s()) check_time_function(c, key + "inlet.flow_rate_m2_s", in.flow_rate_m2_s(), 0.0, "m^2/s");
-    else if (in.has_pressure_pa()) check_time_function(c, key + "inlet.pressure_pa", in.pressure_pa(), 0.0, "Pa");
-    else c.missing(key + "inlet", "one of flow_rate_m2_s { .. } or pressure_pa { .. }");
+    if (in.has_flow_rate_m2_s())
+      check_time_function(c, key + "inlet.flow_rate_m2_s", in.flow_rate_m2_s(), 0.0, "m^2/s");
+    else if (in.has_pressure_pa())
+      check_time_function(c, key + "inlet.pressure_pa", in.pressure_pa(), 0.0, "Pa");
+    else
+      c.missing(key + "inlet", "one of flow_rate_m2_s { .. } or pressure_pa { .. }");
     c.non_negative(key + "inlet.pre_opening_m", in.pre_opening_m(), "m");
     c.non_negative(key + "inlet.pre_opening_length_m", in.pre_opening_length_m(), "m");
   }
   if (f.has_outlet()) {
-    if (!f.outlet().has_pressure_pa()) c.missing(key + "outlet.pressure_pa", "the outlet pressure p(t) (Pa), a TimeFunction");
-    else check_time_function(c, key + "outlet.pressure_pa", f.outlet().pressure_pa(), 0.0, "Pa");
+    if (!f.outlet().has_pressure_pa())
+      c.missing(key + "outlet.pressure_pa", "the outlet pressure p(t) (Pa), a TimeFunction");
+    else
+      check_time_function(c, key + "outlet.pressure_pa", f.outlet().pressure_pa(), 0.0, "Pa");
   }
 
   // Which cracks hold fluid.
@@ -87,7 +93,8 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
     const auto id = f.crack_ids(i);
     const std::string k = key + "crack_ids[" + std::to_string(i) + "]";
     if (id >= cracks.size()) {
-      c.bad(k, std::to_string(id), "a crack id below " + std::to_string(cracks.size()) + " (the solid's cracks, in order)");
+      c.bad(k, std::to_string(id),
+            "a crack id below " + std::to_string(cracks.size()) + " (the solid's cracks, in order)");
     } else if (!seen.insert(id).second) {
       c.bad(k, std::to_string(id), "an id not listed before");
     } else {

@@ -290,12 +290,13 @@ bool on_grid_line(double v, double origin, double h) {
 }
 
 void check_box(Checker& c, const std::string& key, const scene::Box& b) {
-  for (const auto& [name, has, v] : {std::tuple{"x_min_m", b.has_x_min_m(), b.x_min_m()},
-                                     std::tuple{"y_min_m", b.has_y_min_m(), b.y_min_m()},
-                                     std::tuple{"x_max_m", b.has_x_max_m(), b.x_max_m()},
-                                     std::tuple{"y_max_m", b.has_y_max_m(), b.y_max_m()}}) {
-    if (!has) c.missing(key + "." + name, "a coordinate in m");
-    else c.range(key + "." + name, v, -kInf, kInf, false, "m");
+  for (const auto& [name, has, v] :
+       {std::tuple{"x_min_m", b.has_x_min_m(), b.x_min_m()}, std::tuple{"y_min_m", b.has_y_min_m(), b.y_min_m()},
+        std::tuple{"x_max_m", b.has_x_max_m(), b.x_max_m()}, std::tuple{"y_max_m", b.has_y_max_m(), b.y_max_m()}}) {
+    if (!has)
+      c.missing(key + "." + name, "a coordinate in m");
+    else
+      c.range(key + "." + name, v, -kInf, kInf, false, "m");
   }
   if (b.x_max_m() <= b.x_min_m()) c.bad(key + ".x_max_m", text(b.x_max_m()), "> x_min_m = " + text(b.x_min_m()));
   if (b.y_max_m() <= b.y_min_m()) c.bad(key + ".y_max_m", text(b.y_max_m()), "> y_min_m = " + text(b.y_min_m()));
@@ -313,7 +314,8 @@ void check_in_situ_reference(Checker& c, const std::string& key, const scene::Mp
     const auto& r = m.regions(i);
     const std::string k = key + "regions[" + std::to_string(i) + "]";
     if (r.has_polygon()) {
-      c.bad(k + ".polygon", "a polygon", "rectangle or layer regions with in_situ_reference (or in_situ_reference: false)");
+      c.bad(k + ".polygon", "a polygon",
+            "rectangle or layer regions with in_situ_reference (or in_situ_reference: false)");
     }
     for (int j = 0; j < i; ++j) {
       const auto& a = m.regions(j).initial_stress();
@@ -336,8 +338,10 @@ void check_in_situ_reference(Checker& c, const std::string& key, const scene::Mp
 
 void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   const std::string key = "solid.mpm.";
-  if (!m.has_grid()) c.missing(key + "grid", "the grid extent: grid { x_min_m: .. y_min_m: .. x_max_m: .. y_max_m: .. }");
-  else check_box(c, key + "grid", m.grid());
+  if (!m.has_grid())
+    c.missing(key + "grid", "the grid extent: grid { x_min_m: .. y_min_m: .. x_max_m: .. y_max_m: .. }");
+  else
+    check_box(c, key + "grid", m.grid());
   if (!m.has_cell_size_m()) {
     c.missing(key + "cell_size_m", "the cell size (m), > 0");
   } else {
@@ -345,10 +349,11 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
     const double h = m.cell_size_m();
     if (h > 0 && m.has_grid()) {
       const auto& g = m.grid();
-      for (const auto& [name, lo, hi] : {std::tuple{"x_max_m", g.x_min_m(), g.x_max_m()},
-                                         std::tuple{"y_max_m", g.y_min_m(), g.y_max_m()}}) {
+      for (const auto& [name, lo, hi] :
+           {std::tuple{"x_max_m", g.x_min_m(), g.x_max_m()}, std::tuple{"y_max_m", g.y_min_m(), g.y_max_m()}}) {
         if (!on_grid_line(hi, lo, h)) {
-          c.bad(key + "grid." + name, text(hi), "a whole number of cells (cell_size_m = " + text(h) + ") from the minimum");
+          c.bad(key + "grid." + name, text(hi),
+                "a whole number of cells (cell_size_m = " + text(h) + ") from the minimum");
         }
       }
       const double cells = (g.x_max_m() - g.x_min_m()) / h * (g.y_max_m() - g.y_min_m()) / h;
@@ -360,18 +365,26 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   for (int i = 0; i < m.materials_size(); ++i) {
     const auto& mat = m.materials(i);
     const std::string k = key + "materials[" + std::to_string(i) + "].";
-    if (!mat.has_name() || mat.name().empty()) c.missing(k + "name", "a name the regions refer to");
-    else if (!names.insert(mat.name()).second) c.bad(k + "name", "\"" + mat.name() + "\"", "a name not used before");
-    if (!mat.has_youngs_modulus_pa()) c.missing(k + "youngs_modulus_pa", "Young's modulus (Pa), > 0");
-    else c.positive(k + "youngs_modulus_pa", mat.youngs_modulus_pa(), "Pa");
-    if (!mat.has_poisson_ratio()) c.missing(k + "poisson_ratio", "Poisson's ratio, in [0, 0.5)");
+    if (!mat.has_name() || mat.name().empty())
+      c.missing(k + "name", "a name the regions refer to");
+    else if (!names.insert(mat.name()).second)
+      c.bad(k + "name", "\"" + mat.name() + "\"", "a name not used before");
+    if (!mat.has_youngs_modulus_pa())
+      c.missing(k + "youngs_modulus_pa", "Young's modulus (Pa), > 0");
+    else
+      c.positive(k + "youngs_modulus_pa", mat.youngs_modulus_pa(), "Pa");
+    if (!mat.has_poisson_ratio())
+      c.missing(k + "poisson_ratio", "Poisson's ratio, in [0, 0.5)");
     else if (!(mat.poisson_ratio() >= 0 && mat.poisson_ratio() < 0.5)) {
       c.bad(k + "poisson_ratio", text(mat.poisson_ratio()), "a value in [0, 0.5)");
     }
-    if (!mat.has_density_kg_m3()) c.missing(k + "density_kg_m3", "the density (kg/m^3), > 0");
-    else c.positive(k + "density_kg_m3", mat.density_kg_m3(), "kg/m^3");
+    if (!mat.has_density_kg_m3())
+      c.missing(k + "density_kg_m3", "the density (kg/m^3), > 0");
+    else
+      c.positive(k + "density_kg_m3", mat.density_kg_m3(), "kg/m^3");
     if (mat.has_toughness_j_m2() && mat.has_toughness_pa_sqrt_m()) {
-      c.bad(k + "toughness_pa_sqrt_m", text(mat.toughness_pa_sqrt_m()), "unset: toughness_j_m2 is set (give one of them)");
+      c.bad(k + "toughness_pa_sqrt_m", text(mat.toughness_pa_sqrt_m()),
+            "unset: toughness_j_m2 is set (give one of them)");
     }
     if (mat.has_toughness_j_m2()) c.positive(k + "toughness_j_m2", mat.toughness_j_m2(), "J/m^2");
     if (mat.has_toughness_pa_sqrt_m()) c.positive(k + "toughness_pa_sqrt_m", mat.toughness_pa_sqrt_m(), "Pa m^0.5");
@@ -391,7 +404,8 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
         break;
       case scene::RegionSpec::kPolygon:
         if (r.polygon().x_m_size() < 3 || r.polygon().x_m_size() != r.polygon().y_m_size()) {
-          c.bad(k + "polygon", std::to_string(r.polygon().x_m_size()) + " x, " + std::to_string(r.polygon().y_m_size()) + " y",
+          c.bad(k + "polygon",
+                std::to_string(r.polygon().x_m_size()) + " x, " + std::to_string(r.polygon().y_m_size()) + " y",
                 "at least 3 vertices, as many x_m as y_m");
         }
         break;
@@ -465,16 +479,19 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   c.non_negative(key + "damping.grid_alpha_per_s", m.damping().grid_alpha_per_s(), "1/s");
   c.range(key + "damping.pic_fraction", m.damping().pic_fraction(), 0, 1, false, "0 (FLIP) to 1 (PIC)");
   c.non_negative(key + "damping.feedback_q_m2", m.damping().feedback_q_m2(), "m^2");
-  c.non_negative(key + "damping.feedback_target_kinetic_energy_j", m.damping().feedback_target_kinetic_energy_j(), "J/m");
+  c.non_negative(key + "damping.feedback_target_kinetic_energy_j", m.damping().feedback_target_kinetic_energy_j(),
+                 "J/m");
   const auto& f = m.fracture();
   c.range(key + "fracture.j_inner_cells", f.j_inner_cells(), 0, 1e3, true, "cells");
   if (std::isfinite(f.j_inner_cells()) && !(f.j_outer_cells() > f.j_inner_cells() && f.j_outer_cells() <= 1e3)) {
-    c.bad(key + "fracture.j_outer_cells", text(f.j_outer_cells()), "more than j_inner_cells (" + text(f.j_inner_cells()) + ") cells");
+    c.bad(key + "fracture.j_outer_cells", text(f.j_outer_cells()),
+          "more than j_inner_cells (" + text(f.j_inner_cells()) + ") cells");
   }
   c.range(key + "fracture.growth_cells", f.growth_cells(), 0, 1, true, "cells");
   if (f.has_max_lag_cells()) c.range(key + "fracture.max_lag_cells", f.max_lag_cells(), 0, 1e3, false, "cells");
   c.range(key + "fracture.settle_transits", f.settle_transits(), 0, 1e3, false, "shear-wave transits of the crack");
-  if (f.check_interval() < 1) c.bad(key + "fracture.check_interval", std::to_string(f.check_interval()), "at least 1 step");
+  if (f.check_interval() < 1)
+    c.bad(key + "fracture.check_interval", std::to_string(f.check_interval()), "at least 1 step");
   if (f.direction() == scene::FractureSpec::DIRECTION_UNSPECIFIED) {
     c.bad(key + "fracture.direction", "DIRECTION_UNSPECIFIED", "MAX_HOOP_STRESS or STRAIGHT");
   }

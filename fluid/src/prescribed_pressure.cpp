@@ -15,8 +15,7 @@ void PrescribedPressure::set_geometry(const std::vector<CrackGeometry>& cracks) 
       it = std::prev(cracks_.end());
     } else {
       const auto& old_ids = it->geometry.ids;
-      if (geometry.ids.size() < old_ids.size() ||
-          !std::equal(old_ids.begin(), old_ids.end(), geometry.ids.begin())) {
+      if (geometry.ids.size() < old_ids.size() || !std::equal(old_ids.begin(), old_ids.end(), geometry.ids.begin())) {
         throw std::invalid_argument("crack " + std::to_string(geometry.crack_id) +
                                     ": crack-particle ids changed; a crack may only append ids at its tip");
       }
@@ -71,8 +70,8 @@ std::vector<CrackPressure> PrescribedPressure::pressures() const {
     p.crack_id = crack.geometry.crack_id;
     p.ids = crack.geometry.ids;
     p.front_position = config_.front_fraction * crack.arc.back();
-    p.pressure.resize(crack.arc.size());
-    for (std::size_t i = 0; i < crack.arc.size(); ++i) p.pressure[i] = pressure_at(crack.arc[i], p.front_position);
+    p.pressure.reserve(crack.arc.size());
+    for (const double s : crack.arc) p.pressure.push_back(pressure_at(s, p.front_position));
     p.inlet_flux = crack.flux;
     p.fluid_volume = crack.volume;
     out.push_back(std::move(p));

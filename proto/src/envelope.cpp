@@ -42,9 +42,8 @@ protocol::Envelope decode(const void* data, std::size_t size, std::string_view f
                         " bytes that do not parse as an hfmpm Envelope");
   }
   if (has_unknown_fields(envelope)) {
-    throw ProtocolError("malformed message from " + std::string(from) +
-                        ": it carries fields that protocol version " + std::to_string(kProtocolVersion) +
-                        " does not define (a different protocol, or garbage bytes)");
+    throw ProtocolError("malformed message from " + std::string(from) + ": it carries fields that protocol version " +
+                        std::to_string(kProtocolVersion) + " does not define (a different protocol, or garbage bytes)");
   }
   if (envelope.body_case() == protocol::Envelope::BODY_NOT_SET) {
     throw ProtocolError("malformed message from " + std::string(from) + ": an Envelope with no body (" +

@@ -70,9 +70,9 @@ void PrescribedCrack::set_pressure(const CrackPressure& pressure) {
   }
   for (std::size_t i = 0; i < pressure.size(); ++i) {
     if (pressure.ids[i] != crack_.ids[i]) {
-      throw std::invalid_argument("pressure id " + std::to_string(pressure.ids[i]) + " at index " +
-                                  std::to_string(i) + " where crack " + std::to_string(crack_.crack_id) +
-                                  " has particle " + std::to_string(crack_.ids[i]) +
+      throw std::invalid_argument("pressure id " + std::to_string(pressure.ids[i]) + " at index " + std::to_string(i) +
+                                  " where crack " + std::to_string(crack_.crack_id) + " has particle " +
+                                  std::to_string(crack_.ids[i]) +
                                   "; pressure ids must follow the crack's ids in order");
     }
   }

@@ -26,7 +26,8 @@ void usage(std::ostream& out) {
          "once per check; this program plays the coupler and the other side.\n\n"
          "  --role solid|fluid      what the program under test is\n"
          "  --program PATH          the program under test\n"
-         "  --scene FILE            scene for Welcome (default " HFMPM_DEFAULT_SCENE ")\n"
+         "  --scene FILE            scene for Welcome (default " HFMPM_DEFAULT_SCENE
+         ")\n"
          "  --set KEY=VALUE         scene override, repeatable (before each check's own)\n"
          "  --transport ipc|tcp     control and data sockets (default ipc)\n"
          "  --only NAME[,NAME...]   run only these checks\n"

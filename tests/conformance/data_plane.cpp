@@ -68,12 +68,14 @@ protocol::DataFrame Session::expect_frame(std::uint64_t step, double t) {
   const bool right = role_ == protocol::SOLID ? frame->has_crack() : frame->has_fluid();
   if (!right) {
     fail("the DataFrame for step " + std::to_string(step) + " carries " +
-         (frame->has_crack() ? "a CrackState" : frame->has_fluid() ? "a FluidState" : "no payload") + "; a " +
-         side_ + " side sends " + (role_ == protocol::SOLID ? "CrackState" : "FluidState"));
+         (frame->has_crack()   ? "a CrackState"
+          : frame->has_fluid() ? "a FluidState"
+                               : "no payload") +
+         "; a " + side_ + " side sends " + (role_ == protocol::SOLID ? "CrackState" : "FluidState"));
   }
   if (!(std::abs(frame->t() - t) <= 1e-9 * std::max(1.0, std::abs(t)))) {
-    fail("the DataFrame for step " + std::to_string(step) + " has t = " + fmt(frame->t()) + " s; after that step t = " +
-         fmt(t) + " s");
+    fail("the DataFrame for step " + std::to_string(step) + " has t = " + fmt(frame->t()) +
+         " s; after that step t = " + fmt(t) + " s");
   }
   peer_->check(*frame);
   return *frame;
@@ -126,8 +128,8 @@ std::vector<double> Session::send_command(std::uint32_t num_steps, bool write_ou
 
 protocol::StepReport Session::run_command(std::uint32_t num_steps, bool write_output) {
   const std::string what = "StepCommand{first_step " + std::to_string(step_) + ", num_steps " +
-                           std::to_string(num_steps) + ", dt " + fmt(dt_) +
-                           (write_output ? ", write_output" : "") + "}";
+                           std::to_string(num_steps) + ", dt " + fmt(dt_) + (write_output ? ", write_output" : "") +
+                           "}";
   const auto times = send_command(num_steps, write_output);
   for (std::uint32_t i = 0; i < num_steps; ++i) {
     const std::uint64_t step = step_ + i + 1;

@@ -185,8 +185,7 @@ std::string check_nan(Context& context) {
 
 std::vector<Check> error_checks() {
   return {
-      {"error_first_step", "StepCommand with the wrong first_step -> Error(protocol), exit non-zero",
-       check_first_step},
+      {"error_first_step", "StepCommand with the wrong first_step -> Error(protocol), exit non-zero", check_first_step},
       {"error_dt", "StepCommand with dt = 0 -> Error(protocol), exit non-zero", check_dt},
       {"error_num_steps", "num_steps not a multiple of exchange_interval -> Error(protocol), exit non-zero",
        check_num_steps},

@@ -74,8 +74,8 @@ class FakeSolid final : public FakePeer {
       std::size_t i = 0;
       while (i < p.ids.size() && i < ids.size() && p.ids[i] == ids[i]) ++i;
       fail(where + ": " + std::to_string(p.ids.size()) + " ids, differing at index " + std::to_string(i) +
-           " from the " + std::to_string(ids.size()) + " ids of the CrackState of step " +
-           std::to_string(crack_step) + ", the last one the fluid had; pressures follow the crack's ids, in order");
+           " from the " + std::to_string(ids.size()) + " ids of the CrackState of step " + std::to_string(crack_step) +
+           ", the last one the fluid had; pressures follow the crack's ids, in order");
     }
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (p.pressure[i] < 0) {
@@ -119,10 +119,10 @@ class FakeSolid final : public FakePeer {
   std::size_t growth_events() const override { return growth_; }
 
  private:
-  Vec2 mouth_ = Vec2::Zero();     // m
-  Vec2 direction_ = Vec2(1, 0);   // mouth -> tip
-  double spacing_ = 0.01;         // m
-  std::size_t count_ = 21;        // crack particles
+  Vec2 mouth_ = Vec2::Zero();                            // m
+  Vec2 direction_ = Vec2(1, 0);                          // mouth -> tip
+  double spacing_ = 0.01;                                // m
+  std::size_t count_ = 21;                               // crack particles
   TimeFunction opening_ = TimeFunction::constant(1e-3);  // m, width at the mouth
   std::size_t exchanges_ = 0, growth_ = 0, frames_ = 0;
   bool gauss_seidel_ = false;

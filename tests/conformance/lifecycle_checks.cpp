@@ -122,8 +122,8 @@ std::string check_heartbeat_waiting(Context& context) {
   Session s(context, {{"coupling.heartbeat_interval_s=0.2", "coupling.heartbeat_timeout_s=2"}, {}});
   s.start();
   block_on_data_plane(s);
-  const std::uint64_t step = s.peer_sends_first(s.step() + s.exchange_interval()) ? s.step()
-                                                                                  : s.step() + s.exchange_interval();
+  const std::uint64_t step =
+      s.peer_sends_first(s.step() + s.exchange_interval()) ? s.step() : s.step() + s.exchange_interval();
   const auto from = Clock::now();
   while (since(from) < 2.0) {
     if (auto message = s.poll_control(0.05)) {
@@ -135,8 +135,8 @@ std::string check_heartbeat_waiting(Context& context) {
         fail("while blocked after step " + std::to_string(step) + " the side's heartbeat says step " +
              std::to_string(beat.heartbeat.step()) + "; Heartbeat.step is the last completed step");
       }
-      return "heartbeat with waiting_for_peer = true, step " + std::to_string(step) + ", " +
-             seconds_text(since(from)) + " after the side blocked";
+      return "heartbeat with waiting_for_peer = true, step " + std::to_string(step) + ", " + seconds_text(since(from)) +
+             " after the side blocked";
     }
   }
   fail("no heartbeat with waiting_for_peer = true within 2 s while the side was blocked on the data plane");
@@ -203,8 +203,9 @@ std::string check_shutdown_error(Context& context) {
   if (!s.exit_status()) fail("after Shutdown{error: true} the program " + *s.ended() + "; it must exit, not crash");
   // protocol.proto, Shutdown: "exits (status 0 if !error)": a run stopped for an error does not end with 0.
   if (*s.exit_status() == 0) {
-    fail("after Shutdown{error: true} the program exited with status 0; status 0 is for Shutdown{error: false} "
-         "only, so that whoever started the side sees that the run failed");
+    fail(
+        "after Shutdown{error: true} the program exited with status 0; status 0 is for Shutdown{error: false} "
+        "only, so that whoever started the side sees that the run failed");
   }
   return *s.ended() + " " + seconds_text(s.seconds_to_exit(start)) + " after Shutdown{error: true}";
 }
@@ -217,16 +218,18 @@ std::string silence(Context& context, bool blocked) {
   s.set_heartbeats(false);
   const auto last = s.last_sent();
   if (!s.wait_exit(timeout + margin)) {
-    fail("still running " + seconds_text(since(last)) + " after the coupler went silent; heartbeat_timeout_s = " +
-         fmt(timeout) + " s");
+    fail("still running " + seconds_text(since(last)) +
+         " after the coupler went silent; heartbeat_timeout_s = " + fmt(timeout) + " s");
   }
   const double after = s.seconds_to_exit(last);
   const auto status = s.exit_status();
   if (!status) fail("the program " + *s.ended() + " when the coupler went silent; it must exit, not crash");
   if (*status == 0) fail("the program exited with status 0 when it lost the coupler; it must exit non-zero");
   if (after < 0.9 * timeout) {
-    fail("the program gave up " + seconds_text(after) + " after the coupler's last message, before "
-         "heartbeat_timeout_s = " + fmt(timeout) + " s");
+    fail("the program gave up " + seconds_text(after) +
+         " after the coupler's last message, before "
+         "heartbeat_timeout_s = " +
+         fmt(timeout) + " s");
   }
   return *s.ended() + " " + seconds_text(after) + " after the coupler's last message (heartbeat_timeout_s " +
          fmt(timeout) + " s)";

@@ -68,9 +68,9 @@ std::string check_diagnostics(Context& context) {
     s.peer().check_diagnostics(report.diagnostics(), "StepReport of step " + std::to_string(report.step()));
   }
   return "Ready and 10 StepReports: " + std::string(s.role() == protocol::SOLID
-                                                         ? "crack_particles, crack_length, mouth_opening and "
-                                                           "crack_face_load match the frames"
-                                                         : "finite, >= 0, front within the crack");
+                                                        ? "crack_particles, crack_length, mouth_opening and "
+                                                          "crack_face_load match the frames"
+                                                        : "finite, >= 0, front within the crack");
 }
 
 std::string check_frames(Context& context) {

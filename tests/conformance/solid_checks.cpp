@@ -167,9 +167,8 @@ std::string check_solid_growth(Context& context) {
     }
     s.run_command(n);
   }
-  return "the crack grew in " + std::to_string(s.peer().growth_events()) + " frames over " +
-         std::to_string(s.step()) + " steps (t = " + fmt(s.t()) +
-         " s): ids appended only, grew set exactly then, tips closed";
+  return "the crack grew in " + std::to_string(s.peer().growth_events()) + " frames over " + std::to_string(s.step()) +
+         " steps (t = " + fmt(s.t()) + " s): ids appended only, grew set exactly then, tips closed";
 }
 
 }  // namespace

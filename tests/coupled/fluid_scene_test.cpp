@@ -21,11 +21,18 @@ namespace {
 
 std::string scene(double end_s, double interval_s, const std::string& solid, const std::string& fluid) {
   return "name: \"fluid_check\"\n"
-         "time { end_s: " + std::to_string(end_s) + " safety_factor: 0.5 }\n"
-         "output { interval_s: " + std::to_string(interval_s) + " }\n"
+         "time { end_s: " +
+         std::to_string(end_s) +
+         " safety_factor: 0.5 }\n"
+         "output { interval_s: " +
+         std::to_string(interval_s) +
+         " }\n"
          "coupling { transport: IPC control_interval: 50 }\n"
-         "solid { prescribed_crack { " + solid + " } }\n"
-         "fluid { mpm { " + fluid + " } }\n";
+         "solid { prescribed_crack { " +
+         solid +
+         " } }\n"
+         "fluid { mpm { " +
+         fluid + " } }\n";
 }
 
 std::string frame(std::size_t k) {
@@ -54,7 +61,8 @@ TEST(FluidScene, ChannelFillsThenCarriesPoiseuilleFlow) {
   const auto injected = history.values("injected_volume_m2");
   double worst_front = 0;
   for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] < 0.1 || front[i] > 0.99 * L) continue;  // after the start-up (tau = 0.8 ms, ramp 10 ms), before the outlet
+    if (t[i] < 0.1 || front[i] > 0.99 * L)
+      continue;  // after the start-up (tau = 0.8 ms, ramp 10 ms), before the outlet
     // The ramp acts as a constant p_in from t - ramp / 2 (the front law is linear in the integral of p_in).
     const double exact = std::sqrt(s0 * s0 + w * w * p_in * (t[i] - 0.5 * ramp) / (6 * mu));
     worst_front = std::max(worst_front, std::abs(front[i] / exact - 1));
@@ -68,13 +76,15 @@ TEST(FluidScene, ChannelFillsThenCarriesPoiseuilleFlow) {
   const std::size_t last = frames.count() - 1;
   const auto arc = frames.get(last, "nodes0", "arc_length"), p = frames.get(last, "nodes0", "pressure");
   double worst_profile = 0;
-  for (std::size_t i = 0; i < arc.size(); ++i) worst_profile = std::max(worst_profile, std::abs(p[i] - p_in * (1 - arc[i] / L)));
-  std::printf("channel scene: worst front error %.3e while filling; steady flux %+.3e vs the cubic law; "
-              "worst nodal pressure deviation %.3e of p_in\n",
-              worst_front, q / q_exact - 1, worst_profile / p_in);
-  EXPECT_LT(worst_front, 0.01);                    // library Filling test: < 1% at this h
-  EXPECT_NEAR(q / q_exact, 1, 0.01);               // issue 4: the cubic law within 1%
-  EXPECT_LT(worst_profile, 0.01 * p_in);           // lumped projection on a uniform grid: exact for a linear p
+  for (std::size_t i = 0; i < arc.size(); ++i)
+    worst_profile = std::max(worst_profile, std::abs(p[i] - p_in * (1 - arc[i] / L)));
+  std::printf(
+      "channel scene: worst front error %.3e while filling; steady flux %+.3e vs the cubic law; "
+      "worst nodal pressure deviation %.3e of p_in\n",
+      worst_front, q / q_exact - 1, worst_profile / p_in);
+  EXPECT_LT(worst_front, 0.01);           // library Filling test: < 1% at this h
+  EXPECT_NEAR(q / q_exact, 1, 0.01);      // issue 4: the cubic law within 1%
+  EXPECT_LT(worst_profile, 0.01 * p_in);  // lumped projection on a uniform grid: exact for a linear p
   const auto summary = check_xdmf(out + "/fluid.xmf", out + "/fluid.h5");  // throws on any problem
   ASSERT_TRUE(summary.grids.count("fluid0"));
   ASSERT_TRUE(summary.grids.count("nodes0"));
@@ -89,11 +99,12 @@ TEST(FluidScene, PressureDiffusionMatchesErfc) {
   const double tau = rho * w * w / (12 * mu), D = K * w * w / (12 * mu);
   const double t_end = 1000 * tau, L = 8 * std::sqrt(D * t_end);  // 31 m: the far end stays at rest
   const auto out = scratch_dir("diffusion");
-  const std::string text = scene(
-      t_end, t_end, "initial_length_m: " + std::to_string(L) + " spacing_m: " + std::to_string(L / 100) +
-                        " mouth_opening_m { constant: 1e-3 } profile: CHANNEL stable_dt_s: 1",
-      "viscosity_pa_s: 1 particle_length_m: " + std::to_string(L / 200) +
-          " inlet { pressure_pa { constant: 1e5 } } initial_fill { front_m: " + std::to_string(L) + " }");
+  const std::string text =
+      scene(t_end, t_end,
+            "initial_length_m: " + std::to_string(L) + " spacing_m: " + std::to_string(L / 100) +
+                " mouth_opening_m { constant: 1e-3 } profile: CHANNEL stable_dt_s: 1",
+            "viscosity_pa_s: 1 particle_length_m: " + std::to_string(L / 200) +
+                " inlet { pressure_pa { constant: 1e5 } } initial_fill { front_m: " + std::to_string(L) + " }");
   const auto result = run_scene(text, out, {}, 300);
   ASSERT_EQ(result.exit_code, 0) << result.err;
   Frames frames(out + "/fluid.h5");
@@ -113,8 +124,8 @@ TEST(FluidScene, PulseTravelsAtTheSoundSpeed) {
   const double L = 1, rho = 1000, K = 2.2e9, c0 = std::sqrt(K / rho), duration = 0.1 * L / c0;
   const auto out = scratch_dir("wave");
   // Frames every 0.1 L / c0; a raised pulse of 0.1 L / c0 from the inlet into fluid at rest.
-  const std::string table = "table { t: 0 t: " + std::to_string(0.5 * duration) + " t: " + std::to_string(duration) +
-                            " v: 0 v: 1e4 v: 0 }";
+  const std::string table =
+      "table { t: 0 t: " + std::to_string(0.5 * duration) + " t: " + std::to_string(duration) + " v: 0 v: 1e4 v: 0 }";
   const std::string text =
       scene(0.8 * L / c0, 0.1 * L / c0,
             "initial_length_m: 1 spacing_m: 0.01 mouth_opening_m { constant: 1e-3 } profile: CHANNEL stable_dt_s: 1",
@@ -143,13 +154,13 @@ TEST(FluidScene, PulseTravelsAtTheSoundSpeed) {
 TEST(FluidScene, FlowRateInletConservesMassWhileTheCrackGrows) {
   const double T = 0.01, Q0 = 1e-2, rho = 1000;
   const auto out = scratch_dir("inlet_mass");
-  const std::string text = scene(
-      T, T / 10,
-      "initial_length_m: 0.1 growth_speed_m_per_s: 40 max_length_m: 0.5 spacing_m: 0.01 "
-      "mouth_opening_m { power { scale: 1e-3 t_ref: 0.01 exponent: 0.3333333333333333 } } profile: ELLIPTIC "
-      "stable_dt_s: 2e-5",
-      "viscosity_pa_s: 0.1 inlet { flow_rate_m2_s { table { t: 0 t: 0.001 v: 0 v: 1e-2 } } pre_opening_m: 1e-5 } "
-      "max_substeps: 1000");
+  const std::string text =
+      scene(T, T / 10,
+            "initial_length_m: 0.1 growth_speed_m_per_s: 40 max_length_m: 0.5 spacing_m: 0.01 "
+            "mouth_opening_m { power { scale: 1e-3 t_ref: 0.01 exponent: 0.3333333333333333 } } profile: ELLIPTIC "
+            "stable_dt_s: 2e-5",
+            "viscosity_pa_s: 0.1 inlet { flow_rate_m2_s { table { t: 0 t: 0.001 v: 0 v: 1e-2 } } pre_opening_m: 1e-5 } "
+            "max_substeps: 1000");
   const auto result = run_scene(text, out, {}, 300);
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const Csv history = read_csv(out + "/history.csv");
@@ -171,11 +182,11 @@ TEST(FluidScene, FlowRateInletConservesMassWhileTheCrackGrows) {
 
 TEST(FluidScene, FacesPulledApartGiveNoNegativePressure) {
   const auto out = scratch_dir("no_tension");
-  const std::string text =
-      scene(2e-3, 2e-4,
-            "initial_length_m: 1 spacing_m: 0.05 mouth_opening_m { ramp { t0: 5e-4 v0: 1e-4 t1: 1.5e-3 v1: 3e-4 } } "
-            "profile: CHANNEL stable_dt_s: 1e-5",
-            "inlet { flow_rate_m2_s { constant: 0 } } initial_fill { front_m: 0.8 pressure_pa: 1e6 } max_substeps: 100");
+  const std::string text = scene(
+      2e-3, 2e-4,
+      "initial_length_m: 1 spacing_m: 0.05 mouth_opening_m { ramp { t0: 5e-4 v0: 1e-4 t1: 1.5e-3 v1: 3e-4 } } "
+      "profile: CHANNEL stable_dt_s: 1e-5",
+      "inlet { flow_rate_m2_s { constant: 0 } } initial_fill { front_m: 0.8 pressure_pa: 1e6 } max_substeps: 100");
   const auto result = run_scene(text, out, {}, 300);
   ASSERT_EQ(result.exit_code, 0) << result.err;
   Frames frames(out + "/fluid.h5");
@@ -185,7 +196,7 @@ TEST(FluidScene, FacesPulledApartGiveNoNegativePressure) {
       for (double p : frames.get(k, set, "pressure")) min_p = std::min(min_p, p);
     }
   }
-  const auto first = frames.get(0, "fluid0", "pressure");  // t = 0.2 ms, before the faces move
+  const auto first = frames.get(0, "fluid0", "pressure");           // t = 0.2 ms, before the faces move
   EXPECT_GT(*std::max_element(first.begin(), first.end()), 0.5e6);  // compressed behind the release wave from the front
   const auto last = frames.get(frames.count() - 1, "nodes0", "pressure");
   std::printf("faces pulled apart through hfmpm-fluid: min pressure %.3e Pa, final max nodal %.3e Pa\n", min_p,

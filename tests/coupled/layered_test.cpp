@@ -51,7 +51,8 @@ struct Path {
   // y where the path first reaches x (linear between crack particles).
   double y_at(double at) const {
     for (std::size_t i = 1; i < x.size(); ++i) {
-      if (x[i - 1] <= at && at <= x[i] && x[i] > x[i - 1]) return y[i - 1] + (at - x[i - 1]) / (x[i] - x[i - 1]) * (y[i] - y[i - 1]);
+      if (x[i - 1] <= at && at <= x[i] && x[i] > x[i - 1])
+        return y[i - 1] + (at - x[i - 1]) / (x[i] - x[i - 1]) * (y[i] - y[i - 1]);
     }
     return std::nan("");
   }
@@ -67,8 +68,14 @@ struct Path {
 // the crack starts in the soft one.
 Path run_layered(const std::string& name, double viscosity, bool soft_start) {
   const auto out = scratch_dir("layered_" + name);
-  std::vector<std::string> argv = {bin("hfmpm"), "run", source("scenarios/layered-ci.scene"), "--out", out, "--quiet",
-                                   "--set", "fluid.mpm.viscosity_pa_s=" + std::to_string(viscosity)};
+  std::vector<std::string> argv = {bin("hfmpm"),
+                                   "run",
+                                   source("scenarios/layered-ci.scene"),
+                                   "--out",
+                                   out,
+                                   "--quiet",
+                                   "--set",
+                                   "fluid.mpm.viscosity_pa_s=" + std::to_string(viscosity)};
   if (soft_start) {
     argv.push_back("--set");
     argv.push_back(

@@ -45,7 +45,8 @@ TEST(SolidScene, BadFractureSettingsAreRefused) {
       {"solid.mpm.fracture.j_outer_cells=1", "solid.mpm.fracture.j_outer_cells", "more than j_inner_cells"},
       {"solid.mpm.fracture.growth_cells=1.5", "solid.mpm.fracture.growth_cells", "cells"},
       {"solid.mpm.fracture.check_interval=0", "solid.mpm.fracture.check_interval", "at least 1 step"},
-      {"solid.mpm.fracture.direction=DIRECTION_UNSPECIFIED", "solid.mpm.fracture.direction", "MAX_HOOP_STRESS or STRAIGHT"},
+      {"solid.mpm.fracture.direction=DIRECTION_UNSPECIFIED", "solid.mpm.fracture.direction",
+       "MAX_HOOP_STRESS or STRAIGHT"},
       {"solid.mpm.fracture.max_lag_cells=-0.5", "solid.mpm.fracture.max_lag_cells", ">= 0"},
       {"solid.mpm.damping.feedback_q_m2=-1", "solid.mpm.damping.feedback_q_m2", "m^2"},
       {"solid.mpm.materials=[{name: \"rock\" youngs_modulus_pa: 1e10 poisson_ratio: 0.25 density_kg_m3: 2500 "
@@ -86,7 +87,8 @@ TEST(SolidScene, BadFractureSettingsAreRefused) {
 
 TEST(SolidScene, ConfinedBlockSettles) {
   const auto out = scratch_dir("block");
-  const auto result = run({bin("hfmpm"), "run", source("scenarios/confined_block.scene"), "--out", out, "--quiet"}, 300);
+  const auto result =
+      run({bin("hfmpm"), "run", source("scenarios/confined_block.scene"), "--out", out, "--quiet"}, 300);
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto energy = read_csv(out + "/history.csv").values("kinetic_energy_j");
   double peak = 0;

@@ -264,7 +264,6 @@ TEST(FluidSolver, RejectsReorderedIdsAndBadConfig) {
   EXPECT_THROW(FluidSolver{bad}, std::invalid_argument);
 }
 
-
 // -dp/dw at each node against a finite difference: a channel filled at
 // 1e5 Pa (K = 2 MPa), every width widened by 1e-7 of itself, one step of
 // 1e-12 s (nothing moves; the state is recomputed). For a uniform change of
@@ -298,8 +297,10 @@ TEST(FluidSolver, ReportsTheStiffnessOfItsPressureToTheCrackWidth) {
     // K_t J / w at 1e5 Pa: K e^{(1 - J)/c} J / w.
     const double J = fluid.eos().volume_ratio(1e5);
     EXPECT_NEAR(s0[10], -fluid.eos().slope(J) * J / w, 1e-9 * s0[10]);
-    if (kind == InletConfig::Kind::Pressure) EXPECT_EQ(s0[0], 0.0);
-    else EXPECT_GT(s0[0], 0.0);
+    if (kind == InletConfig::Kind::Pressure)
+      EXPECT_EQ(s0[0], 0.0);
+    else
+      EXPECT_GT(s0[0], 0.0);
   }
 }
 
@@ -355,7 +356,7 @@ TEST(FluidSolver, LagPressureBeyondTheFront) {
     const double p_front = fluid.particles().pressure.back();
     EXPECT_NEAR(p_front, 1e5, 1.0);
     for (std::size_t i = 11; i < p.size(); ++i) {
-      const double expected = lag == FluidConfig::Lag::Fixed                ? 7.5e4
+      const double expected = lag == FluidConfig::Lag::Fixed              ? 7.5e4
                               : lag == FluidConfig::Lag::Front && i == 11 ? p_front
                                                                           : 0.0;
       EXPECT_EQ(p[i], expected) << "node " << i;
@@ -363,7 +364,6 @@ TEST(FluidSolver, LagPressureBeyondTheFront) {
     }
   }
 }
-
 
 // A closed far end (no outlet) is a wall even where a virtual opening keeps
 // the tip node open for the fluid: a flow-rate inlet fills the channel, and
@@ -417,7 +417,9 @@ TEST(FluidSolver, MergesParticlesSqueezedAlongTheCrack) {
       const auto& P = fluid.particles();
       for (std::size_t p = 1; p < P.size(); ++p) {
         shortest = std::min(shortest, P.length[p]);
-        if (fraction > 0) ASSERT_GE(P.length[p], fraction * c.particle_length * (1 - 1e-12)) << "step " << k;
+        if (fraction > 0) {
+          ASSERT_GE(P.length[p], fraction * c.particle_length * (1 - 1e-12)) << "step " << k;
+        }
         ASSERT_NEAR(P.end(p - 1), P.start(p), 1e-12) << "particles stay contiguous, step " << k;
       }
       ASSERT_NEAR(fluid.fluid_mass() / fluid.injected_mass(), 1, 1e-12) << "step " << k;
@@ -456,7 +458,9 @@ TEST(FluidSolver, MergingKeepsMassAndExtent) {
   double total = 0;
   for (std::size_t p = 0; p < 5; ++p) {
     total += fluid.particles().length[p];
-    if (p > 0) EXPECT_GE(fluid.particles().length[p], 1.9 * 0.05) << p;
+    if (p > 0) {
+      EXPECT_GE(fluid.particles().length[p], 1.9 * 0.05) << p;
+    }
   }
   EXPECT_NEAR(total, 0.5, 1e-6);
   EXPECT_NEAR(fluid.fluid_mass(), mass, 1e-14 * mass);

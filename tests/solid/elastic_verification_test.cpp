@@ -45,7 +45,8 @@ double measured_period(int cells) {
   Solver solid(bar(cells));
   const double length = 1.0;
   auto& p = solid.particles();
-  for (std::size_t i = 0; i < p.size(); ++i) p.v[i] = Vec2(1e-3 * std::sin(std::numbers::pi * p.x[i].x() / (2 * length)), 0);
+  for (std::size_t i = 0; i < p.size(); ++i)
+    p.v[i] = Vec2(1e-3 * std::sin(std::numbers::pi * p.x[i].x() / (2 * length)), 0);
   const double c = rock().p_wave_speed(rock().density);
   const double period = 4 * length / c;
   const double dt = solid.stable_dt();
@@ -135,7 +136,8 @@ TEST(InSituStress, StrainEnergyOfAUniformStress) {
   const Material m = rock();
   const Voigt s = block_in_situ().regions[0].initial_stress;
   const double nu = m.poisson_ratio;
-  const double exact = 0.5 * (s[0] * s[0] + s[1] * s[1] + s[3] * s[3] - 2 * nu * (s[0] * s[1] + s[1] * s[3] + s[3] * s[0])) /
+  const double exact = 0.5 *
+                       (s[0] * s[0] + s[1] * s[1] + s[3] * s[3] - 2 * nu * (s[0] * s[1] + s[1] * s[3] + s[3] * s[0])) /
                        (2 * m.youngs_modulus);
   EXPECT_NEAR(solid.strain_energy(), exact, 1e-12 * exact);
 }

@@ -25,8 +25,8 @@
 namespace hfmpm::solid::mpm {
 namespace {
 
-constexpr double kP0 = 1e6;    // Pa
-constexpr double kS = 1e14;    // Pa/m: p changes by p0 for a 0.01 um change of width
+constexpr double kP0 = 1e6;  // Pa
+constexpr double kS = 1e14;  // Pa/m: p changes by p0 for a 0.01 um change of width
 
 SolidConfig pressurised_edge_crack(bool implicit) {
   // Edge crack a = 0.3 in a 1 x 1.5 strip (h = W/20), no remote load.
@@ -90,13 +90,14 @@ TEST(FaceStiffness, ImplicitSpringIsStableAndMatchesTheConvergedExplicitAnswer) 
     worst = std::max(worst, std::abs(wi[k] - wr[k]));
     worst_explicit = std::max(worst_explicit, std::abs(we[k] - wr[k]));
   }
-  std::printf("kinetic energy at the end: reference %.3e, implicit %.3e, explicit at dt %.3e J/m; explicit worst "
-              "width difference %.2e of the mouth opening\n",
-              reference.kinetic_energy(), implicit.kinetic_energy(), explicit_step.kinetic_energy(),
-              worst_explicit / wr[0]);
-  std::printf("free mouth opening %.4e m; with the spring: explicit dt/12 %.4e m, implicit dt %.4e m; "
-              "worst width difference %.2e of the mouth opening; explicit at dt %s\n",
-              mouth_free, wr[0], wi[0], worst / wr[0], explicit_survived ? "survived" : "blew up");
+  std::printf(
+      "kinetic energy at the end: reference %.3e, implicit %.3e, explicit at dt %.3e J/m; explicit worst "
+      "width difference %.2e of the mouth opening\n",
+      reference.kinetic_energy(), implicit.kinetic_energy(), explicit_step.kinetic_energy(), worst_explicit / wr[0]);
+  std::printf(
+      "free mouth opening %.4e m; with the spring: explicit dt/12 %.4e m, implicit dt %.4e m; "
+      "worst width difference %.2e of the mouth opening; explicit at dt %s\n",
+      mouth_free, wr[0], wi[0], worst / wr[0], explicit_survived ? "survived" : "blew up");
   // The spring holds the faces at the reference widths to p0 / s = 1e-8 m.
   EXPECT_NEAR(wr[0], w_ref[0], 1e-3 * w_ref[0]);
   EXPECT_LT(worst, 0.01 * wr[0]);
@@ -114,11 +115,11 @@ TEST(FaceStiffness, GrowthEnergyDropsTheShareOfANegativeKI) {
   tip.j = 10;
   tip.k1 = 3;
   tip.k2 = 4;
-  EXPECT_DOUBLE_EQ(growth_energy(tip), 10);                // open: all of J
+  EXPECT_DOUBLE_EQ(growth_energy(tip), 10);                   // open: all of J
   EXPECT_DOUBLE_EQ(growth_energy(tip, true), 10 * 9.0 / 25);  // mode I only (straight by symmetry)
   tip.k1 = -3;
-  EXPECT_DOUBLE_EQ(growth_energy(tip), 10 * 16.0 / 25);    // closed: the K_II share
-  EXPECT_DOUBLE_EQ(growth_energy(tip, true), 0);           // closed, mode I only: nothing
+  EXPECT_DOUBLE_EQ(growth_energy(tip), 10 * 16.0 / 25);  // closed: the K_II share
+  EXPECT_DOUBLE_EQ(growth_energy(tip, true), 0);         // closed, mode I only: nothing
 }
 
 }  // namespace

@@ -47,8 +47,9 @@ TEST(Propagation, EdgeCrackStartsAtToughnessAndGrowsStraight) {
   ASSERT_GT(onset, 0) << "the crack never grew";
   const double sigma_onset = sigma_c * onset / ramp_time;
   const double j_handbook = std::pow(sigma_onset / sigma_c, 2) * kToughness;
-  std::printf("edge crack growth onset at sigma = %.4f sigma_c: handbook J there %.4f J_Ic; J computed at onset %.4f J_Ic\n",
-              sigma_onset / sigma_c, j_handbook / kToughness, solid.last_tips().at(0).j / kToughness);
+  std::printf(
+      "edge crack growth onset at sigma = %.4f sigma_c: handbook J there %.4f J_Ic; J computed at onset %.4f J_Ic\n",
+      sigma_onset / sigma_c, j_handbook / kToughness, solid.last_tips().at(0).j / kToughness);
   // The criterion fires when the computed J reaches J_Ic (not later: the
   // check interval and the load step are small), and physically at the
   // handbook load: K at onset within 5% of K_Ic = sqrt(E' J_Ic).
@@ -190,9 +191,10 @@ TEST(Propagation, CrackInStiffLayerTurnsTowardsSoftLayer) {
   }
   const auto& cr = solid.cracks()[0];
   const double rise = cr.plane().back().y() - y0;
-  std::printf("layered: grew %zu particles, tip at (%.4f, %.4f) m, rise %.3f h towards the soft layer, mean kink %.2f deg\n",
-              cr.size() - initial, cr.plane().back().x(), cr.plane().back().y(), rise / h,
-              checks ? kink_sum / checks * 180 / kPi : 0.0);
+  std::printf(
+      "layered: grew %zu particles, tip at (%.4f, %.4f) m, rise %.3f h towards the soft layer, mean kink %.2f deg\n",
+      cr.size() - initial, cr.plane().back().x(), cr.plane().back().y(), rise / h,
+      checks ? kink_sum / checks * 180 / kPi : 0.0);
   ASSERT_GE(cr.size(), initial + 8) << "the crack did not grow";
   EXPECT_GT(kink_sum / checks, 0) << "the tip turned away from the soft layer";
   EXPECT_GT(rise, 0.05 * h);

@@ -30,7 +30,7 @@ TEST(Ugimp, PartitionOfUnityZeroGradientSumAndLinearReproduction) {
     ASSERT_NEAR(sum, 1.0, 1e-14) << "x = " << x << " lp = " << lp;
     ASSERT_NEAR(grad, 0.0, 1e-12);
     ASSERT_NEAR(first_moment, 0.0, 1e-14);  // sum S_i (x_i - x_p) = 0
-    ASSERT_NEAR(grad_moment, 1.0, 1e-12);  // sum dS_i/dx (x_i - x_p) = 1
+    ASSERT_NEAR(grad_moment, 1.0, 1e-12);   // sum dS_i/dx (x_i - x_p) = 1
   }
 }
 

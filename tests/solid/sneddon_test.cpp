@@ -123,10 +123,11 @@ TEST(Sneddon, OpeningProfileMatchesAndConverges) {
   double previous = 1;
   for (int cells = 5; cells <= finest; cells *= 2) {
     const auto r = run_sneddon(cells, 2);
-    std::printf("sneddon h = a/%d: %zu particles, %llu steps, opening L2 error %.4f, mouth error %+.4f, "
-                "K_I error %+.4f (|K_II|/K_I %.1e, face work %.2f of J)\n",
-                cells, r.particles, static_cast<unsigned long long>(r.steps), r.l2_error, r.mouth_error, r.k_error,
-                r.k2_ratio, r.j_faces_share);
+    std::printf(
+        "sneddon h = a/%d: %zu particles, %llu steps, opening L2 error %.4f, mouth error %+.4f, "
+        "K_I error %+.4f (|K_II|/K_I %.1e, face work %.2f of J)\n",
+        cells, r.particles, static_cast<unsigned long long>(r.steps), r.l2_error, r.mouth_error, r.k_error, r.k2_ratio,
+        r.j_faces_share);
     EXPECT_LT(r.l2_error, 0.8 * previous) << "no convergence at h = a/" << cells;
     if (cells >= 10) {
       EXPECT_LT(r.l2_error, 0.06);
@@ -152,10 +153,10 @@ TEST(Sneddon, InSituStressAsReferenceOpensAsTheNetPressure) {
   const double sigma0 = -10 * kP;
   const auto plain = run_sneddon(10, 2);
   const auto reference = run_sneddon(10, 2, sigma0, true);
-  std::printf("sneddon a/10: L2 error %.4f (no in-situ stress), %.4f (in-situ stress -10 p as reference); "
-              "mouth %+.4f, %+.4f; K_I %+.4f, %+.4f\n",
-              plain.l2_error, reference.l2_error, plain.mouth_error, reference.mouth_error, plain.k_error,
-              reference.k_error);
+  std::printf(
+      "sneddon a/10: L2 error %.4f (no in-situ stress), %.4f (in-situ stress -10 p as reference); "
+      "mouth %+.4f, %+.4f; K_I %+.4f, %+.4f\n",
+      plain.l2_error, reference.l2_error, plain.mouth_error, reference.mouth_error, plain.k_error, reference.k_error);
   EXPECT_LT(reference.l2_error, 0.06);
   EXPECT_LT(std::abs(reference.mouth_error), 0.03);
   EXPECT_LT(std::abs(reference.l2_error - plain.l2_error), 0.005);
@@ -172,10 +173,11 @@ TEST(Sneddon, InSituStressAsReferenceOpensAsTheNetPressure) {
 TEST(Sneddon, CoarseFarFieldOpensAsTheFineBody) {
   const auto fine = run_sneddon(10, 2);
   const auto coarse = run_sneddon(10, 2, 0, false, 2.0);
-  std::printf("sneddon a/10: %zu particles (fine), %zu (coarse far field); L2 error %.4f, %.4f; mouth %+.4f, %+.4f; "
-              "K_I %+.4f, %+.4f\n",
-              fine.particles, coarse.particles, fine.l2_error, coarse.l2_error, fine.mouth_error, coarse.mouth_error,
-              fine.k_error, coarse.k_error);
+  std::printf(
+      "sneddon a/10: %zu particles (fine), %zu (coarse far field); L2 error %.4f, %.4f; mouth %+.4f, %+.4f; "
+      "K_I %+.4f, %+.4f\n",
+      fine.particles, coarse.particles, fine.l2_error, coarse.l2_error, fine.mouth_error, coarse.mouth_error,
+      fine.k_error, coarse.k_error);
   EXPECT_LT(coarse.particles, fine.particles / 2);
   EXPECT_LT(coarse.l2_error, 0.06);
   EXPECT_LT(std::abs(coarse.l2_error - fine.l2_error), 0.005);

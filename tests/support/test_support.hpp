@@ -10,9 +10,9 @@
 
 namespace hfmpm::test {
 
-std::string bin(const std::string& program);      // path of a built program
-std::string source(const std::string& relative);  // path in the source tree
-std::string scratch_dir(const std::string& name); // fresh empty directory under /tmp
+std::string bin(const std::string& program);       // path of a built program
+std::string source(const std::string& relative);   // path in the source tree
+std::string scratch_dir(const std::string& name);  // fresh empty directory under /tmp
 std::string read_file(const std::string& path);
 void write_file(const std::string& path, const std::string& text);
 
@@ -27,8 +27,8 @@ class Process {
   // Waits up to timeout_s. Returns false on timeout (the process keeps running).
   bool wait(double timeout_s);
   bool running();
-  int exit_code() const { return exit_code_; }    // -1 unless it exited normally
-  int term_signal() const { return signal_; }     // 0 unless killed by a signal
+  int exit_code() const { return exit_code_; }  // -1 unless it exited normally
+  int term_signal() const { return signal_; }   // 0 unless killed by a signal
   std::string out() const;
   std::string err() const;
 

@@ -34,7 +34,8 @@ TEST(EnergyWatch, IntegratesTheInletWorkExactlyForALinearRamp) {
   EXPECT_DOUBLE_EQ(watch.initial_energy(), p0 * v0);
   for (int k = 1; k <= 100; ++k) {
     const double t = t_end * k / 100;
-    EXPECT_FALSE(watch.update(t, static_cast<std::uint64_t>(k), solid_with(0), fluid_at(p0 + a * t, q * t, v0 + q * t)));
+    EXPECT_FALSE(
+        watch.update(t, static_cast<std::uint64_t>(k), solid_with(0), fluid_at(p0 + a * t, q * t, v0 + q * t)));
   }
   const double exact = q * (p0 * t_end + a * t_end * t_end / 2);
   EXPECT_NEAR(watch.inlet_work(), exact, 1e-12 * exact);

@@ -56,7 +56,8 @@ inline protocol::Diagnostics sample_diagnostics() {
   protocol::Diagnostics d;
   EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(
       "kinetic_energy: 1.25 crack_length: 0.75 mouth_opening: 1.0e-3 crack_face_load: -3.5e4 inlet_pressure: 2.0e5 "
-      "injected_volume: 6.0e-4 fluid_volume: 5.5e-4 front_position: 0.6 crack_particles: 101 fluid_particles: 77 coupling_lag: 1.5e3 strain_energy: 2.5",
+      "injected_volume: 6.0e-4 fluid_volume: 5.5e-4 front_position: 0.6 crack_particles: 101 fluid_particles: 77 "
+      "coupling_lag: 1.5e3 strain_energy: 2.5",
       &d));
   return d;
 }

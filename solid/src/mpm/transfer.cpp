@@ -26,7 +26,7 @@ void Solver::p2g() {
   if constexpr (kCracks) {
     if (sides_.size() != count) sides_.assign(count, 0);
   }
-#pragma omp parallel num_threads(static_cast<int>(threads))
+#pragma omp parallel num_threads(static_cast <int>(threads))
   {
     const auto k = static_cast<std::size_t>(omp_get_thread_num());
     auto& acc = thread_acc_[k];
@@ -158,7 +158,7 @@ void Solver::g2p(double dt) {
   const auto count = static_cast<std::int64_t>(particles_.size());
   std::int64_t escaped = -1;
   const double runaway = g.h;  // m per step
-#pragma omp parallel for num_threads(static_cast<int>(thread_acc_.size())) schedule(static)
+#pragma omp parallel for num_threads(static_cast <int>(thread_acc_.size())) schedule(static)
   for (std::int64_t q = 0; q < count; ++q) {
     const auto p = static_cast<std::size_t>(q);
     const Vec2 rel = particles_.x[p] - g.origin;
@@ -258,7 +258,6 @@ std::string Solver::runaway_report(std::size_t p, double dt) const {
   out << "Otherwise lower solid.mpm.cfl or time.safety_factor, or check the boundary conditions and loads.";
   return out.str();
 }
-
 
 std::size_t Solver::grid_bytes() const {
   auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };

@@ -47,13 +47,13 @@ struct RunOptions {
 
 struct RunSummary {
   bool ok = false;
-  std::string error;  // names the failed side and step
+  std::string error;       // names the failed side and step
   int interrupted_by = 0;  // the signal that stopped the run (error says so), or 0
   std::uint64_t steps = 0;
   std::uint64_t commands = 0;
   double t = 0;
-  double wall_s = 0;          // whole run
-  double stepping_wall_s = 0; // from the first StepCommand to the last report
+  double wall_s = 0;           // whole run
+  double stepping_wall_s = 0;  // from the first StepCommand to the last report
   double solid_compute_s = 0, fluid_compute_s = 0;
   double solid_exchange_s = 0, fluid_exchange_s = 0;
   bool sides_in_sequence = false;  // Gauss-Seidel: the fluid steps after the solid, not beside it

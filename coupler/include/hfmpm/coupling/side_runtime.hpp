@@ -58,11 +58,11 @@ struct SideOptions {
   std::string implementation;    // e.g. "hfmpm-prescribed-solid"
   std::string implementation_version = "0.1.0";
   std::vector<std::string> capabilities;
-  std::string advertise_host;                                // tcp: host the peer can reach this side at
-  std::string output_dir;                                    // overrides the coupler's output_dir
-  double welcome_timeout_s = 60;                             // the coupler must answer Hello within this
-  zmq::context_t* context = nullptr;                         // shared context (in-process mode); own one if null
-  std::uint32_t protocol_version = proto::kProtocolVersion;  // tests claim others
+  std::string advertise_host;                                       // tcp: host the peer can reach this side at
+  std::string output_dir;                                           // overrides the coupler's output_dir
+  double welcome_timeout_s = 60;                                    // the coupler must answer Hello within this
+  zmq::context_t* context = nullptr;                                // shared context (in-process mode); own one if null
+  std::uint32_t protocol_version = proto::kProtocolVersion;         // tests claim others
   std::uint32_t scene_schema_version = proto::kSceneSchemaVersion;  // tests claim others
   Fault fault;
   // tcp with CURVE (--keys FILE, the sides' key file): the control and

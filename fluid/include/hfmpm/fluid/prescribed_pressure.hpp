@@ -15,8 +15,8 @@ struct PrescribedPressureConfig {
   enum class Profile { Uniform, Linear };
   TimeFunction inlet_pressure;  // Pa, p_inlet(t)
   Profile profile = Profile::Uniform;
-  double front_fraction = 1;    // front at this fraction of the crack length, (0, 1]
-  double stable_dt = 1e-3;      // s, the step this stand-in reports
+  double front_fraction = 1;  // front at this fraction of the crack length, (0, 1]
+  double stable_dt = 1e-3;    // s, the step this stand-in reports
 };
 
 class PrescribedPressure {
@@ -41,7 +41,7 @@ class PrescribedPressure {
     std::vector<double> arc;  // m
     double volume = 0;        // m^2, wetted volume now
     double previous_volume = 0;
-    double flux = 0;          // m^2/s
+    double flux = 0;  // m^2/s
   };
   double pressure_at(double s, double front) const;
   double wetted_volume(const CrackFlow& crack) const;

@@ -1,5 +1,6 @@
 // hfmpm::output::FrameWriter: writes simulation frames (2D point sets with per-point data) to one HDF5
-// file plus an XDMF 2 sidecar (<name>.xmf beside <name>.h5) that ParaView opens directly (docs/architecture.md, "Output files").
+// file plus an XDMF 2 sidecar (<name>.xmf beside <name>.h5) that ParaView opens directly (docs/architecture.md, "Output
+// files").
 //
 // HDF5 layout (all datasets little-endian, contiguous):
 //   /                                 string attributes: "title" and whatever attribute() set

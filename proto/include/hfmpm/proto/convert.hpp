@@ -4,8 +4,8 @@
 #pragma once
 
 #include "hfmpm/exchange.hpp"
-#include "hfmpm/protocol.pb.h"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/protocol.pb.h"
 #include "hfmpm/scene.pb.h"
 #include "hfmpm/time_function.hpp"
 

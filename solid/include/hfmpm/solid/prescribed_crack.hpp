@@ -12,15 +12,15 @@ struct PrescribedCrackConfig {
   // Channel: uniform width up to and including the last particle, which is
   // not a tip (an open far end: a rigid channel for fluid checks).
   enum class Profile { Elliptic, Uniform, Channel };
-  Vec2 mouth = Vec2::Zero();     // m
-  double angle_rad = 0;          // direction mouth -> tip
-  double initial_length = 1;     // m, > 0
-  double growth_speed = 0;       // m/s, >= 0
-  double max_length = 1;         // m, >= initial_length
-  double spacing = 0.1;          // m, target crack-particle spacing
-  TimeFunction mouth_opening;    // m, w_mouth(t)
+  Vec2 mouth = Vec2::Zero();   // m
+  double angle_rad = 0;        // direction mouth -> tip
+  double initial_length = 1;   // m, > 0
+  double growth_speed = 0;     // m/s, >= 0
+  double max_length = 1;       // m, >= initial_length
+  double spacing = 0.1;        // m, target crack-particle spacing
+  TimeFunction mouth_opening;  // m, w_mouth(t)
   Profile profile = Profile::Elliptic;
-  double stable_dt = 1e-3;       // s, the step this stand-in reports
+  double stable_dt = 1e-3;  // s, the step this stand-in reports
 };
 
 class PrescribedCrack {

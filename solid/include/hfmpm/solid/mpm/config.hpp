@@ -21,7 +21,7 @@ struct Region {
   enum class Kind { Rectangle, Polygon, Layer };
   Kind kind = Kind::Rectangle;
   Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();  // Rectangle corners; Layer uses lo.y() .. hi.y()
-  std::vector<Vec2> polygon;                   // Polygon vertices, either orientation
+  std::vector<Vec2> polygon;                  // Polygon vertices, either orientation
   int material = 0;
   Voigt initial_stress = Voigt::Zero();  // Pa, (xx, yy, xy, zz), tension positive
   int particles_per_cell = 0;            // per direction, 1 to 4; 0: SolidConfig's
@@ -36,9 +36,9 @@ enum class Edge { Left, Right, Bottom, Top };
 struct Constraint {
   enum class Kind { PlaneX, PlaneY, Box };
   Kind kind = Kind::PlaneX;
-  double coordinate = 0;                       // m, PlaneX / PlaneY; must lie on a grid line
-  Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();   // Box
-  bool fix_x = true, fix_y = true;             // Box
+  double coordinate = 0;                      // m, PlaneX / PlaneY; must lie on a grid line
+  Vec2 lo = Vec2::Zero(), hi = Vec2::Zero();  // Box
+  bool fix_x = true, fix_y = true;            // Box
 };
 
 // Traction on the particles along one edge of the body: normal (tension
@@ -51,7 +51,7 @@ struct Traction {
 };
 
 struct Damping {
-  double grid_alpha = 0;  // 1/s: grid force -= alpha * momentum
+  double grid_alpha = 0;    // 1/s: grid force -= alpha * momentum
   double pic_fraction = 0;  // 0 = pure FLIP, 1 = pure PIC velocity update
   // Feedback (Nose-Hoover) damping for quasi-static loading: a second grid
   // damping coefficient alpha_f >= 0 that follows
@@ -69,9 +69,9 @@ struct Fracture {
   // within inner_cells cells of the tip, falling linearly to 0 at outer_cells.
   double inner_cells = 2.0;
   double outer_cells = 5.0;
-  bool propagate = false;      // grow tips where J >= J_Ic of the material there
-  double growth_cells = 0.5;   // a new crack particle this many cells ahead of the tip
-  int check_interval = 10;     // steps between checks while propagating (as the scene default)
+  bool propagate = false;     // grow tips where J >= J_Ic of the material there
+  double growth_cells = 0.5;  // a new crack particle this many cells ahead of the tip
+  int check_interval = 10;    // steps between checks while propagating (as the scene default)
   // Mode I by symmetry (a crack on a symmetry line, as in KGD): grow straight
   // on, driven by the mode-I part of J only; K_II there is discretization
   // noise (the side tests put a crack lying on a grid line on one side).
@@ -91,9 +91,9 @@ struct SolidConfig {
   Grid grid;
   std::vector<Material> materials;
   std::vector<Region> regions;
-  int particles_per_cell = 2;    // per direction
-  double cfl = 0.4;              // dt = cfl * h / c_p (with scaled density)
-  double density_scaling = 1;    // every density is multiplied by this (>= 1 for quasi-static speed)
+  int particles_per_cell = 2;  // per direction
+  double cfl = 0.4;            // dt = cfl * h / c_p (with scaled density)
+  double density_scaling = 1;  // every density is multiplied by this (>= 1 for quasi-static speed)
   std::vector<Constraint> constraints;
   std::vector<Traction> tractions;
   std::vector<Edge> silent_edges;  // absorbing (dashpot) edges

@@ -76,7 +76,7 @@ class Crack {
   bool start_is_tip_, end_is_tip_;
   std::vector<std::uint64_t> ids_;
   std::vector<Vec2> plane_, above_, below_;
-  std::vector<double> pressure_;  // Pa, on the faces, per crack particle
+  std::vector<double> pressure_;                     // Pa, on the faces, per crack particle
   std::vector<double> stiffness_, reference_width_;  // Pa/m and m, per crack particle
   double wetted_length_ = -1;
   std::uint64_t next_id_ = 0;

@@ -25,10 +25,10 @@ struct Grid {
 
 // Per-node fields of one velocity field. Index by node number.
 struct NodalFields {
-  std::vector<double> mass;    // kg/m
-  std::vector<Vec2> momentum;  // kg/(m s)
-  std::vector<Vec2> force;     // N/m
-  std::vector<Vec2> displaced; // kg/m * m: sum of S m u (cracks only; / mass = nodal displacement)
+  std::vector<double> mass;         // kg/m
+  std::vector<Vec2> momentum;       // kg/(m s)
+  std::vector<Vec2> force;          // N/m
+  std::vector<Vec2> displaced;      // kg/m * m: sum of S m u (cracks only; / mass = nodal displacement)
   std::vector<std::uint8_t> fixed;  // bit 0: v_x = 0, bit 1: v_y = 0 (constraints; set once)
 
   void resize(std::size_t n) {

@@ -27,9 +27,9 @@ struct Particles {
                                   // in_situ_reference: its change from it; Solver::total_stress)
   // Kept only with cracks (empty otherwise): contact needs the displacement,
   // the J-integral its gradient.
-  std::vector<Vec2> displacement;  // m, since the start
+  std::vector<Vec2> displacement;       // m, since the start
   std::vector<Eigen::Matrix2d> grad_u;  // du_i/dx_j since the start (small strain)
-  std::vector<std::int32_t> material;  // index into the material table
+  std::vector<std::int32_t> material;   // index into the material table
   // Kept only with SolidConfig::in_situ_reference (empty otherwise): the
   // region whose initial stress the particle's stress is measured from.
   std::vector<std::int32_t> region;
