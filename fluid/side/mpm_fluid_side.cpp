@@ -49,6 +49,7 @@ class MpmFluidSide final : public coupling::SideModel {
 
   void advance(double dt) override {
     for (auto& c : cracks_) substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
+    ++steps_;
   }
 
   void publish(protocol::DataFrame& frame) override {
@@ -98,6 +99,13 @@ class MpmFluidSide final : public coupling::SideModel {
   }
 
   void finish() override {
+    if (!config_.implicit_interface && steps_ > 0) {
+      // The fluid's own steps per coupled step (it subcycles at its stable dt).
+      std::fprintf(
+          stderr, "hfmpm-fluid: %.2f fluid steps per coupled step per crack (%llu coupled steps)\n",
+          static_cast<double>(substeps_) / static_cast<double>(steps_ * std::max<std::size_t>(1, cracks_.size())),
+          static_cast<unsigned long long>(steps_));
+    }
     for (const auto& c : cracks_) {
       const auto& s = c.solver;
       if (!config_.implicit_interface || s.steps() == 0) continue;
@@ -179,7 +187,7 @@ class MpmFluidSide final : public coupling::SideModel {
   std::uint32_t max_substeps_ = 1;
   std::vector<FluidCrack> cracks_;
   bool received_ = false;
-  std::uint64_t substeps_ = 0;
+  std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
   std::optional<output::FrameWriter> writer_;
 };
 

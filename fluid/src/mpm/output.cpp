@@ -35,7 +35,6 @@ void FluidSolver::fill(double front, double pressure) {
     const double m = config_.density * l * w / J;  // V0 = V / J at the fill pressure
     particles_.insert(k, a + 0.5 * l, l, m, 0.0);
     reset_reference(k);
-    initial_mass_ += m;
   }
   outlet_wetted_ = config_.outlet.enabled && front >= grid_.length() * (1 - 1e-12);
   update_state();

@@ -158,7 +158,6 @@ class FluidSolver {
   double inlet_flux() const { return inlet_flux_; }
   double injected_volume() const { return injected_mass_ / config_.density; }  // m^2, zero-pressure volume in
   double injected_mass() const { return injected_mass_; }                      // kg/m, through the mouth (net)
-  double initial_mass() const { return initial_mass_; }                        // kg/m, from fill()
   double outflow_mass() const { return outflow_mass_; }                        // kg/m, out through the outlet (net)
   double fluid_mass() const;                                                   // kg/m, sum of particle masses
   double fluid_volume() const;                                                 // m^2, sum of l w
@@ -208,7 +207,7 @@ class FluidSolver {
   double particle_length_ = 0;                 // m, resolved target length
   double t_ = 0;
   std::uint64_t steps_ = 0;
-  double injected_mass_ = 0, initial_mass_ = 0, outflow_mass_ = 0;
+  double injected_mass_ = 0, outflow_mass_ = 0;
   double inlet_flux_ = 0;
   bool outlet_wetted_ = false;
   // implicit interface

@@ -26,7 +26,6 @@ struct Material {
   // Plane-strain modulus E' = E / (1 - nu^2), as in fracture mechanics (K^2 = E' G).
   double plane_strain_modulus() const { return youngs_modulus / (1 - poisson_ratio * poisson_ratio); }
   double p_wave_speed(double density_used) const { return std::sqrt(p_modulus() / density_used); }
-  double s_wave_speed(double density_used) const { return std::sqrt(shear_modulus() / density_used); }
 };
 
 }  // namespace hfmpm::solid::mpm

@@ -95,7 +95,6 @@ class Solver {
   Particles& particles() { return particles_; }
   const Particles& particles() const { return particles_; }
   const NodalFields& nodes() const { return nodes_; }
-  const std::vector<int>& active_nodes() const { return active_; }
   // Particle p's Cauchy stress (Pa): the stored stress, plus its region's
   // initial stress when the particles carry changes (in_situ_reference).
   Voigt total_stress(std::size_t p) const;
@@ -106,8 +105,6 @@ class Solver {
   // Bytes of the grid's arrays as allocated: reduced fields, velocities and
   // accelerations, P2G's per-thread accumulators (for memory reports).
   std::size_t grid_bytes() const;
-  // Particles on each edge of the body (Left, Right, Bottom, Top), found once.
-  const std::vector<std::uint32_t>& edge_particles(Edge edge) const { return edges_[static_cast<std::size_t>(edge)]; }
   std::vector<Crack>& cracks() { return cracks_; }
   const std::vector<Crack>& cracks() const { return cracks_; }
   // The nodal fields of one side of a crack: field 1 holds the particles whose
