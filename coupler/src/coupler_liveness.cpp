@@ -40,7 +40,7 @@ std::optional<std::pair<Side*, protocol::Envelope>> Coupler::pump(microseconds w
     if (!routed->well_framed) throw proto::ProtocolError("a multi-frame message; the protocol sends one frame");
     envelope = proto::decode(routed->payload.data(), routed->payload.size(), "the " + side->name + " side");
   } catch (const proto::ProtocolError& e) {
-    throw RunFailure{"the " + side->name + " side broke the protocol" + at_step() + ": " + e.what()};
+    throw RunFailure{"the " + side->name + " side broke the protocol" + at_step(*side) + ": " + e.what()};
   }
   side->last_heard = Clock::now();
   if (envelope.has_heartbeat()) {
@@ -91,7 +91,7 @@ void Coupler::housekeeping() {
     if (side.thread_exit && side.thread_exit->load() >= 0) {
       const std::string reported = drain_error_from(side);
       throw RunFailure{"the in-process " + side.name + " side ended with code " +
-                       std::to_string(side.thread_exit->load()) + at_step() +
+                       std::to_string(side.thread_exit->load()) + at_step(side) +
                        (reported.empty() ? "" : ": " + reported)};
     }
     if (side.joined && now - side.last_heard > heartbeat_timeout_) {
@@ -113,7 +113,7 @@ void Coupler::housekeeping() {
 
 std::string Coupler::ended_message(Side& side, const std::string& ended) {
   const std::string reported = drain_error_from(side);
-  return "the " + side.name + " side (pid " + std::to_string(side.process->pid()) + ") " + ended + at_step() +
+  return "the " + side.name + " side (pid " + std::to_string(side.process->pid()) + ") " + ended + at_step(side) +
          (reported.empty() ? "" : ": " + reported) + log_hint(side);
 }
 
@@ -138,13 +138,13 @@ void Coupler::send_to(Side& side, const protocol::Envelope& envelope) {
   } catch (const std::exception& e) {
     // Usually the process has just died: say how, rather than that a send failed.
     if (side.process && side.process->wait_for(0.5)) throw RunFailure{ended_message(side, *side.process->poll())};
-    throw RunFailure{"cannot reach the " + side.name + " side" + at_step() + ": " + e.what() + log_hint(side)};
+    throw RunFailure{"cannot reach the " + side.name + " side" + at_step(side) + ": " + e.what() + log_hint(side)};
   }
 }
 
 void Coupler::unexpected(const Side& side, const protocol::Envelope& envelope, const std::string& expected) {
   throw RunFailure{"the " + side.name + " side sent an unexpected " + std::string(proto::body_name(envelope)) +
-                   " message" + at_step() + " where " + expected + " was due"};
+                   " message" + at_step(side) + " where " + expected + " was due"};
 }
 
 }  // namespace hfmpm::coupling::detail

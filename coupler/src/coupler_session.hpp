@@ -116,6 +116,13 @@ class Coupler {
   // --------------------------------------------------------- messages in
   Side* side_named(const std::string& name);
   std::string at_step() const { return " at step " + std::to_string(step_); }
+  // The step a side's fault came at, as near as the coupler knows: its last
+  // heartbeat's step when that is past the start of the current command.
+  std::string at_step(const Side& side) const {
+    if (side.heartbeat_step <= step_) return at_step();
+    return " at step " + std::to_string(side.heartbeat_step) + " (its last heartbeat; the command began at step " +
+           std::to_string(step_) + ")";
+  }
 
   std::string log_hint(const Side& side) const;
 
