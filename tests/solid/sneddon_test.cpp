@@ -129,6 +129,14 @@ TEST(Sneddon, OpeningProfileMatchesAndConverges) {
         cells, r.particles, static_cast<unsigned long long>(r.steps), r.l2_error, r.mouth_error, r.k_error, r.k2_ratio,
         r.j_faces_share);
     EXPECT_LT(r.l2_error, 0.8 * previous) << "no convergence at h = a/" << cells;
+    if (cells > 5) {
+      // Observed order log2(e(2h) / e(h)): first order (the square-root tip
+      // spans a few cells; measured 1.01 for a/5 -> a/10, 0.83 for a/10 ->
+      // a/20); held above 0.75.
+      const double order = std::log2(previous / r.l2_error);
+      std::printf("sneddon: observed order %.2f at h = a/%d\n", order, cells);
+      EXPECT_GT(order, 0.75);
+    }
     if (cells >= 10) {
       EXPECT_LT(r.l2_error, 0.06);
       EXPECT_LT(std::abs(r.mouth_error), 0.03);
