@@ -77,14 +77,10 @@ class MpmFluidSide final : public coupling::SideModel {
       }
       const bool had_grid = !crack->solver.grid().empty();
       try {
+        if (had_grid) check_crack_update(geometry.crack_id, crack->solver.grid().ids(), geometry.ids, &geometry.grew);
         crack->solver.set_crack(geometry);
       } catch (const std::invalid_argument& e) {
         throw proto::ProtocolError(std::string("CrackState: ") + e.what());
-      }
-      if (had_grid && geometry.grew != (crack->solver.grid().appended() > 0)) {
-        throw proto::ProtocolError("CrackState: crack " + std::to_string(geometry.crack_id) + ": 'grew' is " +
-                                   (geometry.grew ? "true" : "false") + " but " +
-                                   std::to_string(crack->solver.grid().appended()) + " ids were appended");
       }
       if (!had_grid && fill_) fill(*crack);
     }

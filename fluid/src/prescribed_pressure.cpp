@@ -14,16 +14,7 @@ void PrescribedPressure::set_geometry(const std::vector<CrackGeometry>& cracks) 
       cracks_.push_back(CrackFlow{});
       it = std::prev(cracks_.end());
     } else {
-      const auto& old_ids = it->geometry.ids;
-      if (geometry.ids.size() < old_ids.size() || !std::equal(old_ids.begin(), old_ids.end(), geometry.ids.begin())) {
-        throw std::invalid_argument("crack " + std::to_string(geometry.crack_id) +
-                                    ": crack-particle ids changed; a crack may only append ids at its tip");
-      }
-      if (geometry.grew != (geometry.ids.size() > old_ids.size())) {
-        throw std::invalid_argument("crack " + std::to_string(geometry.crack_id) + ": 'grew' is " +
-                                    (geometry.grew ? "true" : "false") + " but " +
-                                    std::to_string(geometry.ids.size() - old_ids.size()) + " ids were appended");
-      }
+      check_crack_update(geometry.crack_id, it->geometry.ids, geometry.ids, &geometry.grew);
     }
     it->geometry = geometry;
     it->arc = arc_length(geometry.position);

@@ -90,7 +90,7 @@ class MpmSolidSide final : public coupling::SideModel {
       }
       const auto pressure = proto::from_proto(c);
       const auto& ids = solver_->cracks()[c.crack_id()].ids();
-      if (pressure.size() > ids.size() || !std::equal(pressure.ids.begin(), pressure.ids.end(), ids.begin())) {
+      if (!ids_are_prefix(pressure.ids, ids)) {
         throw proto::ProtocolError("FluidState crack " + std::to_string(c.crack_id()) +
                                    ": its ids must be the crack's ids in order (a prefix while the crack grows)");
       }

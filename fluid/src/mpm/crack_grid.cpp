@@ -30,17 +30,11 @@ void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_o
     reject(id, "ids, positions and widths must have the same size (" + std::to_string(n) + ", " +
                    std::to_string(crack.position.size()) + ", " + std::to_string(crack.width.size()) + ")");
   }
-  if (n < ids_.size()) {
-    reject(id, "has " + std::to_string(n) + " crack particles, fewer than the " + std::to_string(ids_.size()) +
-                   " it had: crack particles may not disappear");
-  }
-  for (std::size_t i = 0; i < ids_.size(); ++i) {
-    if (crack.ids[i] != ids_[i]) {
-      std::ostringstream out;
-      out << "crack particle " << i << " has id " << crack.ids[i] << " but had id " << ids_[i]
-          << ": ids may only be appended at the tip, never reordered or removed";
-      reject(id, out.str());
-    }
+  std::size_t appended = n;
+  try {
+    appended = check_crack_update(id, ids_, crack.ids);  // the first crack: every id is new
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("fluid: ") + e.what());
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (!(crack.width[i] >= 0) || !std::isfinite(crack.width[i])) {
@@ -62,7 +56,7 @@ void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_o
     }
     min_spacing = std::min(min_spacing, h);
   }
-  appended_ = n - ids_.size();
+  appended_ = appended;
   crack_id_ = id;
   ids_ = crack.ids;
   position_ = crack.position;

@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace hfmpm {
@@ -70,6 +72,44 @@ struct SideDiagnostics {
   std::uint32_t crack_particles = 0;
   std::uint32_t fluid_particles = 0;
 };
+
+// The protocol's crack-update rule (docs/protocol.md, CrackState), in one
+// place for every side: a crack keeps its particles' ids in order and only
+// appends new ones at its tip; `grew` (when given) says whether it appended
+// since the previous CrackState. Returns the number of ids appended; throws
+// std::invalid_argument naming the crack and what broke.
+inline std::size_t check_crack_update(std::uint32_t crack_id, const std::vector<std::uint64_t>& before,
+                                      const std::vector<std::uint64_t>& now, const bool* grew = nullptr) {
+  const std::string crack = "crack " + std::to_string(crack_id) + ": ";
+  if (now.size() < before.size()) {
+    throw std::invalid_argument(crack + "has " + std::to_string(now.size()) + " crack particles, fewer than the " +
+                                std::to_string(before.size()) + " it had: crack particles may not disappear");
+  }
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    if (now[i] != before[i]) {
+      throw std::invalid_argument(crack + "crack particle " + std::to_string(i) + " has id " + std::to_string(now[i]) +
+                                  " but had id " + std::to_string(before[i]) +
+                                  ": ids may only be appended at the tip, never reordered or removed");
+    }
+  }
+  const std::size_t appended = now.size() - before.size();
+  if (grew && *grew != (appended > 0)) {
+    throw std::invalid_argument(crack + "'grew' is " + (*grew ? "true" : "false") + " but " + std::to_string(appended) +
+                                " ids were appended");
+  }
+  return appended;
+}
+
+// The FluidState rule: the ids a fluid answers with are the crack's ids in
+// order, or a prefix of them while the crack grows (under Jacobi the fluid
+// answers with the ids of the crack it last received).
+inline bool ids_are_prefix(const std::vector<std::uint64_t>& prefix, const std::vector<std::uint64_t>& ids) {
+  if (prefix.size() > ids.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    if (prefix[i] != ids[i]) return false;
+  }
+  return true;
+}
 
 // Arc length of each point of a polyline from its first point.
 inline std::vector<double> arc_length(const std::vector<Vec2>& points) {
