@@ -30,6 +30,14 @@ void Coupler::handshake() {
   };
   const auto& coupling = scene_.coupling();
   wait_until([](const Side& s) { return !s.joined; }, "Hello", "coupling.join_timeout_s", coupling.join_timeout_s());
+  // Every side has read the key file before its Hello: remove the sides'
+  // secret from /tmp now, not at the end, so a coupler killed later (kill -9
+  // leaves no chance to clean up) does not leave it behind.
+  if (!keys_dir_.empty()) {
+    std::error_code ignored;
+    fs::remove_all(keys_dir_, ignored);
+    keys_dir_.clear();
+  }
 
   // Setup (building each model) happens between Welcome and Ready; heartbeats
   // prove the sides alive meanwhile, so this limit can be generous.
