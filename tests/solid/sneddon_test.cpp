@@ -41,15 +41,18 @@ struct SneddonResult {
 // net load, and the reference opening, stay those of p.
 // near_box > 0: one particle per cell (per direction) in the body, two within
 // x < near_box a, |y| < near_box a / 2 (a later region, so it wins there).
+// rock: the material (default kRock). widths: if given, the face openings
+// at 8, 10 and 12 transits (for the drift test).
 SneddonResult run_sneddon(int cells_per_a, int threads, double sigma0 = 0, bool in_situ_reference = false,
-                          double near_box = 0) {
+                          double near_box = 0, const Material& rock = kRock,
+                          std::vector<std::vector<double>>* widths = nullptr) {
   const double h = kA / cells_per_a;
   SolidConfig c;
   c.grid.origin = Vec2(0, -kB - 2 * h);
   c.grid.h = h;
   c.grid.nx = static_cast<int>(std::lround(kB / h)) + 2;
   c.grid.ny = static_cast<int>(std::lround(2 * kB / h)) + 4;
-  c.materials = {kRock};
+  c.materials = {rock};
   Region r;
   r.lo = Vec2(0, -kB);
   r.hi = Vec2(kB, kB);
@@ -80,16 +83,22 @@ SneddonResult run_sneddon(int cells_per_a, int threads, double sigma0 = 0, bool 
   crack.end_is_tip = true;
   c.cracks = {crack};
   // Damping near critical for the lowest modes of the box.
-  const double c_p = kRock.p_wave_speed(kRock.density);
+  const double c_p = rock.p_wave_speed(rock.density);
   c.damping.grid_alpha = 2 * std::numbers::pi * c_p / (4 * kB);
   c.threads = threads;
   Solver solid(c);
   solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), kP - sigma0));
   const double dt = solid.stable_dt();
   const double transit = 2 * kB / c_p;
-  while (solid.time() < 12 * transit) solid.step(dt);
+  for (int transits : {8, 10, 12}) {
+    while (solid.time() < transits * transit) solid.step(dt);
+    if (widths) {
+      widths->emplace_back();
+      for (std::size_t k = 0; k < solid.cracks()[0].size(); ++k) widths->back().push_back(solid.cracks()[0].width(k));
+    }
+  }
 
-  const double e_prime = kRock.plane_strain_modulus();
+  const double e_prime = rock.plane_strain_modulus();
   const double factor = finite_width_factor(kA, kB);
   const auto& cr = solid.cracks()[0];
   double num = 0, den = 0;
@@ -157,6 +166,42 @@ TEST(Sneddon, OpeningProfileMatchesAndConverges) {
 // must open as the plain case: the same 6% (L2) and 3% (mouth), and the same
 // profile to 0.5% (L2; measured: 4.82% in both, and with the in-situ stress
 // kept in the particles).
+// Issue 19's near-tip drift: a soft material (p/E = 0.05, five hundred
+// times sneddon.scene's) with the crack on a node row, as here. The issue saw
+// the face point next to the tip open without bound through the run (to five
+// times its exact opening). Not reproduced since the face-load sliver limit
+// of issue 18 (docs/solid.md): at p/E = 1e-3 (a/20), 1e-2 and 5e-2 (a/10) the
+// openings are steady to 4 digits from 4 transits on (by hand with
+// scenarios/sneddon.scene). Held here: between 8 and 12 transits no face
+// point's opening moves by more than 0.5% of the largest opening, none
+// exceeds 1.2 x the exact largest opening, and the profile's L2 error falls
+// under refinement. Measured: drift 3.0e-7 (a/5) and 1.9e-5 (a/10) of the
+// largest opening; widest 1.024 and 1.074 of it; L2 error 7.9% and 6.6% (at
+// this p/E the small-strain reference itself is off by a few percent).
+TEST(Sneddon, SoftMaterialOnANodeRowHasNoNearTipDrift) {
+  const Material soft{"soft", 2e7, 0.25, 2500};
+  const double largest = finite_width_factor(kA, kB) * 4 * kP * kA / soft.plane_strain_modulus();
+  double previous = 1;
+  for (int cells : {5, 10}) {
+    std::vector<std::vector<double>> widths;
+    const auto r = run_sneddon(cells, 2, 0, false, 0, soft, &widths);
+    ASSERT_EQ(widths.size(), 3u);
+    double drift = 0, widest = 0;
+    for (std::size_t k = 0; k < widths[0].size(); ++k) {
+      drift = std::max({drift, std::abs(widths[2][k] - widths[0][k]), std::abs(widths[1][k] - widths[0][k])});
+      for (const auto& w : widths) widest = std::max(widest, w[k]);
+    }
+    std::printf(
+        "sneddon p/E = 0.05, h = a/%d: opening L2 error %.4f, largest drift over 8-12 transits %.2e of the "
+        "mouth opening, widest %.4f of it\n",
+        cells, r.l2_error, drift / largest, widest / largest);
+    EXPECT_LT(drift, 5e-3 * largest) << "a face point drifts at h = a/" << cells;
+    EXPECT_LT(widest, 1.2 * largest) << "h = a/" << cells;
+    EXPECT_LT(r.l2_error, previous) << "h = a/" << cells;
+    previous = r.l2_error;
+  }
+}
+
 TEST(Sneddon, InSituStressAsReferenceOpensAsTheNetPressure) {
   const double sigma0 = -10 * kP;
   const auto plain = run_sneddon(10, 2);
