@@ -73,6 +73,20 @@ void Coupler::check_stop_request() const {
 void Coupler::housekeeping() {
   const auto now = Clock::now();
   if (now - last_housekeeping_ < milliseconds(5)) return;
+  // The coupler runs this every few milliseconds while it waits. A gap of
+  // half a heartbeat timeout means the coupler itself did not run (stopped
+  // with SIGSTOP, or starved by the machine): the sides' silence over it is
+  // the coupler's, not theirs (with --transport inproc the side threads were
+  // stopped with it), so their clocks move on by the gap.
+  const auto gap = now - last_housekeeping_;
+  if (last_housekeeping_ != Clock::time_point{} && gap > heartbeat_timeout_ / 2) {
+    for (auto& side : sides_) side.last_heard += std::chrono::duration_cast<Clock::duration>(gap);
+    stalled_ += std::chrono::duration_cast<Clock::duration>(gap);  // and the step timeout (await_reports)
+    std::ostringstream out;
+    out << "the coupler did not run for " << std::chrono::duration<double>(gap).count() << " s" << at_step()
+        << " (stopped or starved); the sides' silence over that time is not counted against them";
+    log_.file_only(out.str());
+  }
   last_housekeeping_ = now;
   if (!stepping_) check_stop_request();  // while the sides join; in the loop, between rounds
   if (zap_) {
@@ -112,7 +126,12 @@ void Coupler::housekeeping() {
 }
 
 std::string Coupler::ended_message(Side& side, const std::string& ended) {
-  const std::string reported = drain_error_from(side);
+  std::string reported = drain_error_from(side);
+  if (reported.empty() && side.process->exit_status() == std::optional<int>(kSideCouplerLost)) {
+    reported =
+        "it lost the coupler (exit status 4: nothing from the coupler for coupling.heartbeat_timeout_s; was "
+        "the coupler stopped or starved?)";
+  }
   return "the " + side.name + " side (pid " + std::to_string(side.process->pid()) + ") " + ended + at_step(side) +
          (reported.empty() ? "" : ": " + reported) + log_hint(side);
 }

@@ -284,10 +284,17 @@ void Coupler::await_reports(std::uint64_t step, double t, double timeout_s) {
     }
     return false;
   };
+  const auto stalled_before = stalled_;
   while (pending()) {
-    if (Clock::now() > deadline) throw RunFailure{hung_message(timeout_s)};
     auto message = pump(milliseconds(20));
-    if (!message) continue;
+    if (!message) {
+      // Time the coupler itself was stopped does not count against the sides
+      // (housekeeping() measures it; again here, as the stop may have come
+      // during the wait that pump() has just finished).
+      housekeeping();
+      if (Clock::now() - (stalled_ - stalled_before) > deadline) throw RunFailure{hung_message(timeout_s)};
+      continue;
+    }
     auto& [side, envelope] = *message;
     if (!envelope.has_step_report() || side->report) unexpected(*side, envelope, "StepReport");
     const auto& report = envelope.step_report();

@@ -181,6 +181,7 @@ class Coupler {
   Progress progress_;
   microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};
   Clock::time_point start_ = Clock::now(), last_housekeeping_{};
+  Clock::duration stalled_{};  // time the coupler itself did not run (housekeeping())
   std::uint64_t step_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
   std::unique_ptr<EnergyWatch> energy_;

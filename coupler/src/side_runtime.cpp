@@ -246,12 +246,26 @@ class SideRuntime {
     }
   }
 
+  // Has the coupler been silent for heartbeat_timeout_? A wait that took far
+  // longer than it asked for means this process did not run (stopped, or
+  // starved; with --transport inproc the coupler stopped with it): that time
+  // is not the coupler's silence, and its clock starts again.
+  bool coupler_silent(Clock::time_point wait_start, microseconds asked) {
+    const auto now = Clock::now();
+    if (now - wait_start > asked + asked / 2 + std::chrono::milliseconds(100)) {
+      last_from_coupler_ = now;
+      return false;
+    }
+    return now - last_from_coupler_ > heartbeat_timeout_;
+  }
+
   // Next message from the coupler that is not a heartbeat. Shutdown throws.
   protocol::Envelope next_command() {
     while (true) {
+      const auto wait_start = Clock::now();
       auto envelope = receive(control_, "the coupler", heartbeat_timeout_);
       if (!envelope) {
-        if (Clock::now() - last_from_coupler_ > heartbeat_timeout_) {
+        if (coupler_silent(wait_start, heartbeat_timeout_)) {
           throw CouplerLost{"nothing from the coupler for " +
                             std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) + " s"};
         }
@@ -353,9 +367,10 @@ class SideRuntime {
     const std::string bytes = proto::encode(envelope);
     while (!data_->send(zmq::buffer(bytes), zmq::send_flags::dontwait)) {
       zmq::pollitem_t items[] = {{data_->handle(), 0, ZMQ_POLLOUT, 0}, {control_.handle(), 0, ZMQ_POLLIN, 0}};
+      const auto wait_start = Clock::now();
       zmq::poll(items, 2, std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_));
       if (items[1].revents & ZMQ_POLLIN) watch_coupler("to send data to the " + peer_ + " side");
-      if (!(items[0].revents & ZMQ_POLLOUT) && Clock::now() - last_from_coupler_ > heartbeat_timeout_) {
+      if (!(items[0].revents & ZMQ_POLLOUT) && coupler_silent(wait_start, heartbeat_timeout_)) {
         throw CouplerLost{"nothing from the coupler for " +
                           std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) +
                           " s while waiting to send data to the " + peer_ + " side"};
@@ -385,6 +400,7 @@ class SideRuntime {
       const bool spinning = Clock::now() < spin_end;
       const auto timeout = spinning ? std::chrono::milliseconds(0)
                                     : std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_);
+      const auto wait_start = Clock::now();
       zmq::poll(items, 2, timeout);
       if (items[0].revents & ZMQ_POLLIN) {
         auto envelope = receive(*data_, "the " + peer_ + " side (data plane)", microseconds(0));
@@ -398,7 +414,7 @@ class SideRuntime {
         watch_coupler("for data from the " + peer_ + " side");
         continue;
       }
-      if (!spinning && Clock::now() - last_from_coupler_ > heartbeat_timeout_) {
+      if (!spinning && coupler_silent(wait_start, std::chrono::duration_cast<microseconds>(timeout))) {
         throw CouplerLost{"nothing from the coupler for " +
                           std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) +
                           " s while waiting for the " + peer_ + " side's data"};

@@ -425,5 +425,28 @@ TEST(Failure, OversizedFrameFromAStrangerIsDropped) {
   expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
 }
 
+// With --transport inproc the sides are threads of the coupler's process:
+// stopping the process (SIGSTOP) for four heartbeat timeouts stops them all.
+// The coupler sees that it did not run itself and does not blame a side; the
+// run completes with the same history as without the stop.
+TEST(Failure, AStoppedInprocCouplerBlamesNoSide) {
+  const auto reference = scratch_dir("stopped-ref");
+  ASSERT_EQ(run_scene(prescribed_scene(2.0), reference, {"--transport", "inproc"}).exit_code, 0);
+  const auto out = scratch_dir("stopped");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(2.0));
+  std::vector<std::string> argv{bin("hfmpm"), "run", scene, "--out", out, "--quiet", "--transport", "inproc"};
+  argv.insert(argv.end(), kFastLiveness.begin(), kFastLiveness.end());
+  Process coupler(argv);
+  for (int i = 0; i < 500 && history_rows(out) < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  kill(coupler.pid(), SIGSTOP);
+  std::this_thread::sleep_for(std::chrono::seconds(4));  // the heartbeat timeout is 1 s
+  kill(coupler.pid(), SIGCONT);
+  ASSERT_TRUE(coupler.wait(60 + kBusyMarginS));
+  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
+  EXPECT_NE(read_file(out + "/coupler.log").find("the coupler did not run for"), std::string::npos);
+  expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
+}
+
 }  // namespace
 }  // namespace hfmpm::test
