@@ -1,8 +1,15 @@
 #!/usr/bin/python3
 """Compare a KGD run with the plane-strain hydraulic fracture solutions and plot it.
 
+    /usr/bin/python3 tools/kgd_plot.py RUN_DIR [--out RUN_DIR/kgd.png]
     /usr/bin/python3 tools/kgd_plot.py RUN_DIR --E 1e7 --nu 0.25 --mu 0.01 --Q 2.5e-4 \
-        --KIc 100 --sigma0 1e5 [--t0 0.05] [--out RUN_DIR/kgd.png]
+        --KIc 100 --sigma0 1e5 [--t0 0.05]
+
+The physical parameters come from RUN_DIR/scene.json (the scene the run used, every default
+filled in, written by every run): E, nu and K_Ic of the material at the crack's mouth, mu of
+the fluid, Q = 2 x the inlet's flow rate (the half model's wing takes Q/2; the rate of a
+ramp's end), sigma0 = -yy of the in-situ stress there, t0 = half the inlet ramp's duration
+(the time shift of a linear ramp). A flag overrides the scene's value.
 
 RUN_DIR is an `hfmpm run --out` directory (history.csv; solid.h5 and fluid.h5 for the
 profiles at the end). Q is the TOTAL injection rate (both wings; the simulated wing takes
@@ -26,6 +33,7 @@ References (E' = E/(1-nu^2), mu' = 12 mu, K' = sqrt(32/pi) K_Ic, Q total):
 t0 shifts the simulated time for a ramped injection (t_eff = t - t0; half the ramp time).
 """
 import argparse
+import json
 import csv
 import math
 import os
@@ -64,17 +72,64 @@ def read_history(path):
     return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
+def scene_parameters(run):
+    """E, nu, mu, Q, KIc, sigma0 and t0 of a KGD run, from RUN/scene.json."""
+    path = os.path.join(run, "scene.json")
+    if not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        scene = json.load(f)
+    mpm = scene.get("solid", {}).get("mpm")
+    fluid = scene.get("fluid", {}).get("mpm")
+    if not mpm or not fluid or not mpm.get("cracks"):
+        sys.exit(f"kgd_plot: {path} is not a KGD scene (an MPM solid with a crack and an MPM fluid); give the flags")
+    crack = mpm["cracks"][0]
+    mouth = (float(crack["x_m"][0]), float(crack["y_m"][0]))
+    region = None  # the last region that holds the mouth, as the solver assigns material
+    for r in mpm.get("regions", []):
+        box = r.get("rectangle") or {}
+        layer = r.get("layer") or {}
+        if box and box["x_min_m"] <= mouth[0] <= box["x_max_m"] and box["y_min_m"] <= mouth[1] <= box["y_max_m"]:
+            region = r
+        elif layer and layer["y_min_m"] <= mouth[1] <= layer["y_max_m"]:
+            region = r
+    if region is None:
+        sys.exit(f"kgd_plot: no region of {path} holds the crack's mouth {mouth}; give the flags")
+    material = next(m for m in mpm["materials"] if m["name"] == region["material"])
+    inlet = fluid.get("inlet", {}).get("flow_rate_m2_s")
+    if not inlet:
+        sys.exit(f"kgd_plot: {path} has no flow-rate inlet; give --Q")
+    if "ramp" in inlet:
+        q, t0 = float(inlet["ramp"]["v1"]), 0.5 * (float(inlet["ramp"]["t1"]) - float(inlet["ramp"].get("t0", 0)))
+    elif "constant" in inlet:
+        q, t0 = float(inlet["constant"]), 0.0
+    else:
+        sys.exit(f"kgd_plot: {path}: the inlet's rate is neither a constant nor a ramp; give --Q and --t0")
+    symmetric = any("symmetry_x_m" in c and abs(float(c["symmetry_x_m"]) - mouth[0]) < 1e-12
+                    for c in mpm.get("constraints", []))
+    stress = region.get("initial_stress", {})
+    return {"E": float(material["youngs_modulus_pa"]), "nu": float(material["poisson_ratio"]),
+            "KIc": float(material.get("toughness_pa_sqrt_m", 0)), "mu": float(fluid["viscosity_pa_s"]),
+            "Q": (2 if symmetric else 1) * q, "sigma0": -float(stress.get("yy_pa", 0)), "t0": t0}
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("run", help="run directory (history.csv, solid.h5, fluid.h5)")
-    for name, default in (("E", 1e7), ("nu", 0.25), ("mu", 0.01), ("Q", 2.5e-4), ("KIc", 100.0), ("sigma0", 1e5),
-                          ("t0", 0.0)):
-        ap.add_argument("--" + name, type=float, default=default)
+    ap.add_argument("run", help="run directory (history.csv, scene.json, solid.h5, fluid.h5)")
+    for name in ("E", "nu", "mu", "Q", "KIc", "sigma0", "t0"):
+        ap.add_argument("--" + name, type=float, help="overrides the value from RUN/scene.json")
     ap.add_argument("--out", help="PNG path (default RUN/kgd.png)")
     ap.add_argument("--reference", choices=("vertex", "gdk"), default="vertex",
                     help="print errors against the vertex Km selects (default) or Geertsma-de Klerk "
                          "(length and opening; no pressure)")
     a = ap.parse_args()
+    from_scene = scene_parameters(a.run)
+    for name in ("E", "nu", "mu", "Q", "KIc", "sigma0", "t0"):
+        if getattr(a, name) is None:
+            if name not in from_scene:
+                sys.exit(f"kgd_plot: --{name} is needed: {a.run}/scene.json is missing (runs write it since 3 December)")
+            setattr(a, name, from_scene[name])
+    print("parameters: " + ", ".join(f"{n} = {getattr(a, n):g}" for n in ("E", "nu", "mu", "Q", "KIc", "sigma0", "t0")))
     h = read_history(os.path.join(a.run, "history.csv"))
     t = h["time_s"]
     L0 = h["crack_length_m"][0]

@@ -66,30 +66,6 @@ std::unique_ptr<coupling::SideModel> make_inproc_side(protocol::Role role, const
   return scene.fluid().has_mpm() ? fluid::make_mpm_fluid_side() : fluid::make_prescribed_fluid_side();
 }
 
-// Sets every unset scalar that has a default, in every message present, so
-// that 'validate' shows each value the run will use.
-void fill_defaults(google::protobuf::Message& message) {
-  const auto* type = message.GetDescriptor();
-  const auto* reflection = message.GetReflection();
-  for (int i = 0; i < type->field_count(); ++i) {
-    const auto* field = type->field(i);
-    if (field->is_repeated() || field->real_containing_oneof()) {
-      if (field->real_containing_oneof() && field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE &&
-          reflection->HasField(message, field)) {
-        fill_defaults(*reflection->MutableMessage(&message, field));
-      }
-      continue;
-    }
-    if (field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE) {
-      if (reflection->HasField(message, field)) fill_defaults(*reflection->MutableMessage(&message, field));
-    } else if (!reflection->HasField(message, field) && field->has_default_value()) {
-      std::string text;
-      google::protobuf::TextFormat::PrintFieldValueToString(message, field, -1, &text);
-      google::protobuf::TextFormat::ParseFieldValueFromString(text, field, &message);
-    }
-  }
-}
-
 int keygen(const std::vector<std::string>& args) {
   if (args.size() != 1 || args[0].empty() || args[0][0] == '-') {
     throw UsageError("'hfmpm keygen' takes one directory: hfmpm keygen DIR");
@@ -158,11 +134,7 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   if (scene_path.empty()) throw UsageError("no scene file given");
   const scene::Scene scene = coupling::load_scene(scene_path, overrides);
   if (command == "validate") {
-    scene::Scene filled = scene;
-    filled.mutable_time();  // blocks whose every field has a default
-    filled.mutable_output();
-    filled.mutable_coupling();
-    fill_defaults(filled);
+    const scene::Scene filled = coupling::with_defaults(scene);
     std::string text;
     google::protobuf::TextFormat::PrintToString(filled, &text);
     std::cout << "# " << scene_path << ": valid\n" << text;

@@ -1,5 +1,7 @@
 // The coupler's run: start (output, endpoints, launching the sides), the
 // run as a whole, and shutdown. See coupler_session.hpp for the parts.
+#include <google/protobuf/util/json_util.h>
+
 #include "coupler_session.hpp"
 
 namespace hfmpm::coupling {
@@ -160,6 +162,17 @@ void Coupler::prepare() {
   manifest_.set_number("protocol_version", proto::kProtocolVersion);
   prepared_ = true;
   history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
+  {
+    // The scene the run uses, every default filled in, as JSON: what a plot
+    // or a script reads instead of repeating the scene's values.
+    std::string json;
+    google::protobuf::util::JsonPrintOptions print;
+    print.add_whitespace = true;
+    print.preserve_proto_field_names = true;
+    if (google::protobuf::util::MessageToJsonString(with_defaults(scene_), &json, print).ok()) {
+      std::ofstream(output_dir_ + "/scene.json") << json;
+    }
+  }
 
   router_.set(zmq::sockopt::linger, kLingerMs);
   router_.set(zmq::sockopt::router_mandatory, 1);

@@ -267,4 +267,44 @@ scene::Scene load_scene(const std::string& path, const std::vector<std::string>&
   return parse_scene(text.str(), path, overrides);
 }
 
+namespace {
+
+void fill_defaults(google::protobuf::Message& message) {
+  const auto* type = message.GetDescriptor();
+  const auto* reflection = message.GetReflection();
+  for (int i = 0; i < type->field_count(); ++i) {
+    const auto* field = type->field(i);
+    if (field->is_repeated() || field->real_containing_oneof()) {
+      if (field->real_containing_oneof() && field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE &&
+          reflection->HasField(message, field)) {
+        fill_defaults(*reflection->MutableMessage(&message, field));
+      }
+      if (field->is_repeated() && field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE) {
+        for (int k = 0; k < reflection->FieldSize(message, field); ++k) {
+          fill_defaults(*reflection->MutableRepeatedMessage(&message, field, k));
+        }
+      }
+      continue;
+    }
+    if (field->cpp_type() == google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE) {
+      if (reflection->HasField(message, field)) fill_defaults(*reflection->MutableMessage(&message, field));
+    } else if (!reflection->HasField(message, field) && field->has_default_value()) {
+      std::string text;
+      google::protobuf::TextFormat::PrintFieldValueToString(message, field, -1, &text);
+      google::protobuf::TextFormat::ParseFieldValueFromString(text, field, &message);
+    }
+  }
+}
+
+}  // namespace
+
+scene::Scene with_defaults(const scene::Scene& scene) {
+  scene::Scene filled = scene;
+  filled.mutable_time();  // blocks whose every field has a default
+  filled.mutable_output();
+  filled.mutable_coupling();
+  fill_defaults(filled);
+  return filled;
+}
+
 }  // namespace hfmpm::coupling

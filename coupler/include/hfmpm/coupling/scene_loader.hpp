@@ -55,4 +55,9 @@ inline constexpr double kMaxRunSteps = 1e9;
 // Effective values used by the coupler.
 double output_interval(const scene::Scene& scene);
 
+// The scene with every unset scalar that has a default set to it, in every
+// block present (and time, output and coupling, whose every key has one):
+// what `hfmpm validate` prints and what the run writes to scene.json.
+scene::Scene with_defaults(const scene::Scene& scene);
+
 }  // namespace hfmpm::coupling
