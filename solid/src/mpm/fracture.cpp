@@ -143,25 +143,20 @@ std::vector<TipResult> Solver::tips() const {
   return out;
 }
 
-TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
-  const Crack& crack = cracks_[c];
+// The tip frame: x1 along the crack's direction over the J domain's inner
+// radius (the chord from the crack point ri behind the tip), not the last
+// segment's. The domain integral sees the crack at that scale: just after a
+// kink the segment points along the kink, the K_II measured in its frame is
+// still the unkinked crack's, and a second kink from the segment counted the
+// first one twice (hydraulic fractures beside an interface spiralled,
+// scenarios/layered.scene at 1e-3 Pa s). For a straight crack the same.
+Solver::TipFrame Solver::tip_frame(const Crack& crack, bool at_end, double ri) {
   const std::size_t n = crack.size();
-  // Particles in order from the far end to the tip.
-  auto at = [&](std::size_t i) { return at_end ? i : n - 1 - i; };
-  const int up = at_end ? 1 : -1;  // the surface on the tip frame's +x2 side
-  TipResult tip;
-  tip.crack = c;
-  tip.at_end = at_end;
-  tip.position = crack.plane()[at(n - 1)];
-  const double h = config_.grid.h;
-  const double ri = config_.fracture.inner_cells * h, ro = config_.fracture.outer_cells * h;
-  // The tip frame's x1 is the crack's direction over the domain's inner
-  // radius (the chord from the crack point ri behind the tip), not the last
-  // segment's. The domain integral sees the crack at that scale: just after a
-  // kink the segment points along the kink, the K_II measured in its frame is
-  // still the unkinked crack's, and a second kink from the segment counted the
-  // first one twice (hydraulic fractures beside an interface spiralled,
-  // scenarios/layered.scene at 1e-3 Pa s). For a straight crack the same.
+  auto at = [&](std::size_t i) { return at_end ? i : n - 1 - i; };  // from the far end to the tip
+  TipFrame f;
+  f.at_end = at_end;
+  f.up = at_end ? 1 : -1;
+  f.position = crack.plane()[at(n - 1)];
   Vec2 back = crack.plane()[at(0)];
   double along = 0;
   for (std::size_t i = n - 1; i > 0; --i) {
@@ -174,53 +169,51 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
     }
     along += len;
   }
-  const Vec2 e1 = (tip.position - back).normalized();
-  const Vec2 e2(-e1.y(), e1.x());
-  tip.direction = e1;
+  f.e1 = (f.position - back).normalized();
+  f.e2 = Vec2(-f.e1.y(), f.e1.x());
+  f.rot.row(0) = f.e1.transpose();
+  f.rot.row(1) = f.e2.transpose();
+  return f;
+}
 
-  // Material at the tip (the region there, else the nearest particle's).
-  const int r = region_at(tip.position);
+// Material at a point: the region there, else the nearest particle's.
+std::size_t Solver::material_at(const Vec2& x) const {
+  const int r = region_at(x);
+  if (r >= 0) return static_cast<std::size_t>(config_.regions[static_cast<std::size_t>(r)].material);
   std::size_t material = 0;
-  if (r >= 0) {
-    material = static_cast<std::size_t>(config_.regions[static_cast<std::size_t>(r)].material);
-  } else {
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
-      const double dist = (particles_.x[p] - tip.position).squaredNorm();
-      if (dist < best) {
-        best = dist;
-        material = static_cast<std::size_t>(particles_.material[p]);
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const double dist = (particles_.x[p] - x).squaredNorm();
+    if (dist < best) {
+      best = dist;
+      material = static_cast<std::size_t>(particles_.material[p]);
+    }
+  }
+  return material;
+}
+
+namespace {
+
+// The side of the crack a point behind the tip lies on (+1: the tip frame's
+// +x2 side, i.e. surface `up`), from the nearest crack segment near the tip
+// with the side tests' exact predicate and convention (a point on the crack
+// line counts as above), so that a particle gets the auxiliary field of the
+// side whose field it uses.
+class CrackSide {
+ public:
+  CrackSide(const Crack& crack, const Vec2& tip, double radius, int up) : crack_(crack), up_(up) {
+    for (std::size_t k = 0; k + 1 < crack.size(); ++k) {  // k: the segment from crack particle k to k + 1
+      if ((crack.plane()[k] - tip).norm() < radius || (crack.plane()[k + 1] - tip).norm() < radius) {
+        near_.push_back(k);
       }
     }
   }
-  tip.material = material;
-  tip.modulus = config_.materials[material].plane_strain_modulus();
-  tip.toughness = config_.materials[material].toughness;
-  const double mu = shear_[material];
-  const double kappa = 3 - 4 * lambda_[material] / (2 * (lambda_[material] + mu));  // 3 - 4 nu
-
-  Eigen::Matrix2d rot;  // rows e1, e2: global -> tip frame
-  rot.row(0) = e1.transpose();
-  rot.row(1) = e2.transpose();
-
-  // The crack segments near the tip, and the side of the crack a point
-  // behind the tip lies on (+1: the tip frame's +x2 side, i.e. surface `up`),
-  // from the nearest of them with the side tests' exact predicate and
-  // convention (a point on the crack line counts as above), so that a
-  // particle gets the auxiliary field of the side whose field it uses.
-  std::vector<std::size_t> near_segments;  // k: the segment from crack particle k to k + 1
-  for (std::size_t k = 0; k + 1 < n; ++k) {
-    if ((crack.plane()[k] - tip.position).norm() < 2.2 * ro + 2 * h ||
-        (crack.plane()[k + 1] - tip.position).norm() < 2.2 * ro + 2 * h) {
-      near_segments.push_back(k);
-    }
-  }
-  auto side = [&](const Vec2& x) {
+  int operator()(const Vec2& x) const {
     double best = std::numeric_limits<double>::infinity();
-    std::size_t nearest = near_segments.front();
-    for (const std::size_t k : near_segments) {
-      const Vec2& a = crack.plane()[k];
-      const Vec2 t = crack.plane()[k + 1] - a;
+    std::size_t nearest = near_.front();
+    for (const std::size_t k : near_) {
+      const Vec2& a = crack_.plane()[k];
+      const Vec2 t = crack_.plane()[k + 1] - a;
       const double f = std::clamp((x - a).dot(t) / t.squaredNorm(), 0.0, 1.0);
       const double dist = (x - a - f * t).squaredNorm();
       if (dist < best) {
@@ -228,19 +221,42 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
         nearest = k;
       }
     }
-    return orient2d(crack.plane()[nearest], crack.plane()[nearest + 1], x) >= 0 ? up : -up;
-  };
+    return orient2d(crack_.plane()[nearest], crack_.plane()[nearest + 1], x) >= 0 ? up_ : -up_;
+  }
 
-  // Area integrals over the particles in the domain: J, and the interaction
-  // integrals m1, m2 with the unit mode I and mode II near-tip fields.
-  double j_area = 0, m1 = 0, m2 = 0;
+ private:
+  const Crack& crack_;
+  int up_;
+  std::vector<std::size_t> near_;
+};
+
+// Kink by maximum hoop stress with K_I >= 0: a closed crack (faces in
+// contact) has no opening singularity, and a negative K_I from M is the
+// discretization's residual interpenetration; it kinks as in pure mode II.
+double max_hoop_stress_kink(double k1_measured, double k2) {
+  const double k1 = std::max(0.0, k1_measured);
+  if (!(std::abs(k2) > 1e-12 * k1)) return 0.0;
+  return 2 * std::atan((k1 - std::sqrt(k1 * k1 + 8 * k2 * k2)) / (4 * k2));
+}
+
+}  // namespace
+
+// Area integrals over the particles in the domain: J, and the interaction
+// integrals m1, m2 with the unit mode I and mode II near-tip fields.
+Solver::TipSums Solver::domain_integrals(const Crack& crack, const TipFrame& f, double ri, double ro,
+                                         std::size_t material) const {
+  const double h = config_.grid.h;
+  const double mu = shear_[material];
+  const double kappa = 3 - 4 * lambda_[material] / (2 * (lambda_[material] + mu));  // 3 - 4 nu
+  const CrackSide side(crack, f.position, 2.2 * ro + 2 * h, f.up);
+  TipSums sums;
   for (std::size_t p = 0; p < particles_.size(); ++p) {
-    const Vec2 d = particles_.x[p] - tip.position;
+    const Vec2 d = particles_.x[p] - f.position;
     if (std::abs(d.x()) >= ro * 1.5 || std::abs(d.y()) >= ro * 1.5) continue;  // cheap reject (any rotation)
-    const double x1 = d.dot(e1), x2 = d.dot(e2);
+    const double x1 = d.dot(f.e1), x2 = d.dot(f.e2);
     const auto w = domain_weight(x1, x2, ri, ro);
     if (w.dq1 == 0 && w.dq2 == 0) continue;
-    const Eigen::Matrix2d g = rot * particles_.grad_u[p] * rot.transpose();  // du_i/dx_j in the tip frame
+    const Eigen::Matrix2d g = f.rot * particles_.grad_u[p] * f.rot.transpose();  // du_i/dx_j in the tip frame
     const auto m = static_cast<std::size_t>(particles_.material[p]);
     const double e11 = g(0, 0), e22 = g(1, 1), e12 = 0.5 * (g(0, 1) + g(1, 0));
     const double tr = e11 + e22;
@@ -250,7 +266,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
     const double energy = 0.5 * (s11 * e11 + s22 * e22 + 2 * s12 * e12);
     const double volume = particles_.volume[p];
     // (sigma_i1 u_i,1 - W) q,1 + sigma_i2 u_i,1 q,2
-    j_area += volume * ((s11 * g(0, 0) + s12 * g(1, 0) - energy) * w.dq1 + (s12 * g(0, 0) + s22 * g(1, 0)) * w.dq2);
+    sums.j += volume * ((s11 * g(0, 0) + s12 * g(1, 0) - energy) * w.dq1 + (s12 * g(0, 0) + s22 * g(1, 0)) * w.dq2);
     // The angle about the tip: behind it, on the particle's side of the
     // crack, continued past +-pi where the crack bends away from the x1 axis
     // (the auxiliary field's cut is the crack, not the axis).
@@ -267,48 +283,64 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
       const double i1 =
           s11 * a.u11 + s12 * a.u21 + a.s11 * g(0, 0) + a.s12 * g(1, 0) - (a.s11 * e11 + a.s22 * e22 + 2 * a.s12 * e12);
       const double i2 = s12 * a.u11 + s22 * a.u21 + a.s12 * g(0, 0) + a.s22 * g(1, 0);
-      (mode == 0 ? m1 : m2) += volume * (i1 * w.dq1 + i2 * w.dq2);
+      (mode == 0 ? sums.m1 : sums.m2) += volume * (i1 * w.dq1 + i2 * w.dq2);
     }
   }
+  return sums;
+}
 
-  // Work of the face loads: -integral q (p n + sigma0 n) . d[u]/dx1 ds for J,
-  // and the same with the auxiliary jump for m1, m2 (8 sqrt(r / 2 pi) / E'
-  // along e2 in mode I, along e1 in mode II).
-  auto jump = [&](std::size_t k) -> Vec2 { return crack.surface(up)[k] - crack.surface(-up)[k]; };
+// Work of the face loads: -integral q (p n + sigma0 n) . d[u]/dx1 ds for J,
+// and the same with the auxiliary jump for m1, m2 (8 sqrt(r / 2 pi) / E'
+// along e2 in mode I, along e1 in mode II).
+Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double ri, double ro, double modulus) const {
+  const std::size_t n = crack.size();
+  auto at = [&](std::size_t i) { return f.at_end ? i : n - 1 - i; };
+  auto jump = [&](std::size_t k) -> Vec2 { return crack.surface(f.up)[k] - crack.surface(-f.up)[k]; };
   auto aux_jump = [&](std::size_t k) {
-    return 8 * std::sqrt((crack.plane()[k] - tip.position).norm() / (2 * kPi)) / tip.modulus;
+    return 8 * std::sqrt((crack.plane()[k] - f.position).norm() / (2 * kPi)) / modulus;
   };
-  double j_faces = 0, m1_faces = 0, m2_faces = 0;
+  TipSums sums;
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const std::size_t a = at(i), b = at(i + 1);
     const Vec2 mid = 0.5 * (crack.plane()[a] + crack.plane()[b]);
-    const Vec2 d = mid - tip.position;
-    const double q = domain_weight(d.dot(e1), d.dot(e2), ri, ro).q;
+    const Vec2 d = mid - f.position;
+    const double q = domain_weight(d.dot(f.e1), d.dot(f.e2), ri, ro).q;
     if (q == 0) continue;
     const Vec2 t = (crack.plane()[b] - crack.plane()[a]).normalized();
     const Vec2 n_up(-t.y(), t.x());
     Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
     const Voigt s0 = in_situ_stress(mid);
     load += traction(s0, n_up);
-    j_faces -= q * load.dot(jump(b) - jump(a));
+    sums.j -= q * load.dot(jump(b) - jump(a));
     const double step = aux_jump(b) - aux_jump(a);
-    m1_faces -= q * load.dot(e2) * step;
-    m2_faces -= q * load.dot(e1) * step;
+    sums.m1 -= q * load.dot(f.e2) * step;
+    sums.m2 -= q * load.dot(f.e1) * step;
   }
-  tip.j = j_area + j_faces;
-  tip.j_faces = j_faces;
-  m1 += m1_faces;
-  m2 += m2_faces;
+  return sums;
+}
 
-  tip.k1 = tip.modulus * m1 / 2;
-  tip.k2 = tip.modulus * m2 / 2;
-  // Kink by maximum hoop stress with K_I >= 0: a closed crack (faces in
-  // contact) has no opening singularity, and a negative K_I from M is the
-  // discretization's residual interpenetration; it kinks as in pure mode II.
-  const double k1 = std::max(0.0, tip.k1);
-  if (std::abs(tip.k2) > 1e-12 * k1) {
-    tip.kink = 2 * std::atan((k1 - std::sqrt(k1 * k1 + 8 * tip.k2 * tip.k2)) / (4 * tip.k2));
-  }
+// J, K_I and K_II at one tip of crack c, and the kink: the frame, the
+// material, the domain's area integrals and the face loads' work.
+TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
+  const Crack& crack = cracks_[c];
+  const double h = config_.grid.h;
+  const double ri = config_.fracture.inner_cells * h, ro = config_.fracture.outer_cells * h;
+  const TipFrame frame = tip_frame(crack, at_end, ri);
+  TipResult tip;
+  tip.crack = c;
+  tip.at_end = at_end;
+  tip.position = frame.position;
+  tip.direction = frame.e1;
+  tip.material = material_at(tip.position);
+  tip.modulus = config_.materials[tip.material].plane_strain_modulus();
+  tip.toughness = config_.materials[tip.material].toughness;
+  const TipSums area = domain_integrals(crack, frame, ri, ro, tip.material);
+  const TipSums faces = face_work(crack, frame, ri, ro, tip.modulus);
+  tip.j = area.j + faces.j;
+  tip.j_faces = faces.j;
+  tip.k1 = tip.modulus * (area.m1 + faces.m1) / 2;
+  tip.k2 = tip.modulus * (area.m2 + faces.m2) / 2;
+  tip.kink = max_hoop_stress_kink(tip.k1, tip.k2);
   return tip;
 }
 

@@ -160,6 +160,20 @@ class Solver {
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
   void contact(double dt);
 
+  // J and K at a tip, in named steps (fracture.cpp).
+  struct TipFrame {
+    Vec2 position, e1, e2;  // the tip, the frame's axes (x1 along the crack)
+    Eigen::Matrix2d rot;    // rows e1, e2: global -> tip frame
+    bool at_end = true;
+    int up = 1;  // the crack surface on the frame's +x2 side
+  };
+  struct TipSums {
+    double j = 0, m1 = 0, m2 = 0;  // J and the interaction integrals
+  };
+  static TipFrame tip_frame(const Crack& crack, bool at_end, double ri);
+  std::size_t material_at(const Vec2& x) const;
+  TipSums domain_integrals(const Crack& crack, const TipFrame& frame, double ri, double ro, std::size_t material) const;
+  TipSums face_work(const Crack& crack, const TipFrame& frame, double ri, double ro, double modulus) const;
   TipResult evaluate_tip(std::size_t c, bool at_end) const;
   std::string runaway_report(std::size_t p, double dt) const;
   void update_feedback(double dt);
