@@ -15,139 +15,168 @@
 
 namespace hfmpm::solid::mpm {
 
+// P2G: each thread zeroes the band of grid rows its particles reach in its
+// own accumulator, scatters its particles into it, and (after all have)
+// reduces one slice of the nodes over every thread's band into the fields.
 template <bool kCracks>
 void Solver::p2g() {
-  const auto& g = config_.grid;
   const auto threads = thread_acc_.size();
   const std::size_t count = particles_.size();
-  constexpr std::size_t F = kCracks ? 2 : 1;  // fields per node in the accumulators
-  const std::size_t row = static_cast<std::size_t>(g.nodes_x());
-  const std::uint32_t epoch = epoch_;
   if constexpr (kCracks) {
     if (sides_.size() != count) sides_.assign(count, 0);
   }
 #pragma omp parallel num_threads(static_cast <int>(threads))
   {
     const auto k = static_cast<std::size_t>(omp_get_thread_num());
-    auto& acc = thread_acc_[k];
     const std::size_t begin = count * k / threads;
     const std::size_t end = count * (k + 1) / threads;
-    // The rows of nodes this thread's particles reach (particles are stored
-    // row by row, so each thread's span is a band of the grid): zero them.
-    double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
-    for (std::size_t p = begin; p < end; ++p) {
-      y_lo = std::min(y_lo, particles_.x[p].y());
-      y_hi = std::max(y_hi, particles_.x[p].y());
-    }
-    std::array<std::size_t, 2> span{0, 0};
-    if (begin < end) {
-      const auto row_of = [&](double y) { return static_cast<int>(std::floor((y - g.origin.y()) / g.h + 0.5)); };
-      // One row more each way than the stencil's reach, against rounding.
-      const int j0 = std::clamp(row_of(y_lo) - 2, 0, g.ny);
-      const int j1 = std::clamp(row_of(y_hi) + 2, 0, g.ny);
-      span = {static_cast<std::size_t>(j0) * row, static_cast<std::size_t>(j1 + 1) * row};
-      std::fill(acc.begin() + static_cast<std::ptrdiff_t>(span[0] * F),
-                acc.begin() + static_cast<std::ptrdiff_t>(span[1] * F), NodeAcc{});
-    }
-    thread_span_[k] = span;
-    for (std::size_t p = begin; p < end; ++p) {
-      const Vec2 x = particles_.x[p];
-      const Vec2 rel = x - g.origin;
-      const double lp = particles_.half_size[p];
-      const auto sx = ugimp_stencil(rel.x(), g.h, lp);
-      const auto sy = ugimp_stencil(rel.y(), g.h, lp);
-      const double m = particles_.mass[p];
-      const Vec2 mv = m * particles_.v[p];
-      const Voigt& s = particles_.stress[p];
-      const double vol = particles_.volume[p];
-      bool near = false;
-      std::uint16_t sides = 0;
-      Vec2 mu = Vec2::Zero();
-      if constexpr (kCracks) {
-        near = near_crack(x);
-        if (near) sides = 1u << 15;
-        mu = m * particles_.displacement[p];
-      }
-      for (int b = 0; b < 3; ++b) {
-        const int j = sy.first + b;
-        if (j < 0 || j > g.ny) continue;
-        const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
-        for (int a = 0; a < 3; ++a) {
-          const int i = sx.first + a;
-          if (i < 0 || i > g.nx) continue;
-          const double w = sx.s[static_cast<std::size_t>(a)] * syb;
-          if (w == 0) continue;
-          const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
-          const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
-          const auto n = static_cast<std::size_t>(g.node(i, j));
-          std::size_t slot = n * F;
-          if constexpr (kCracks) {
-            if (near && field_of(x, g.position(static_cast<int>(n)))) {
-              ++slot;
-              sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
-            }
-          }
-          NodeAcc& f = acc[slot];
-          f.m += w * m;
-          f.px += w * mv.x();
-          f.py += w * mv.y();
-          // internal force -V sigma . grad S (s = xx, yy, xy, zz)
-          f.fx -= vol * (s[0] * gx + s[2] * gy);
-          f.fy -= vol * (s[2] * gx + s[1] * gy);
-          if constexpr (kCracks) {
-            f.ux += w * mu.x();
-            f.uy += w * mu.y();
-          }
-        }
-      }
-      if constexpr (kCracks) sides_[p] = sides;
-    }
+    thread_span_[k] = p2g_zero_band<kCracks>(k, begin, end);
+    p2g_scatter<kCracks>(k, begin, end);
 #pragma omp barrier
-    // Reduce the spans into the fields: each thread a slice of the nodes.
-    std::size_t lo = std::numeric_limits<std::size_t>::max(), hi = 0;
-    for (const auto& sp : thread_span_) {
-      if (sp[0] < sp[1]) {
-        lo = std::min(lo, sp[0]);
-        hi = std::max(hi, sp[1]);
-      }
-    }
-    auto& active = thread_active_[k];
-    active.clear();
-    if (lo < hi) {
-      const std::size_t first = lo + (hi - lo) * k / threads, last = lo + (hi - lo) * (k + 1) / threads;
-      for (std::size_t u = first; u < last; ++u) {
-        NodeAcc sum[F] = {};
-        for (std::size_t t = 0; t < threads; ++t) {
-          const auto& sp = thread_span_[t];
-          if (u < sp[0] || u >= sp[1]) continue;
-          for (std::size_t f = 0; f < F; ++f) {
-            const NodeAcc& from = thread_acc_[t][u * F + f];
-            sum[f].m += from.m;
-            sum[f].px += from.px;
-            sum[f].py += from.py;
-            sum[f].fx += from.fx;
-            sum[f].fy += from.fy;
-            sum[f].ux += from.ux;
-            sum[f].uy += from.uy;
-          }
-        }
-        bool touched = sum[0].m > 0;
-        if constexpr (kCracks) touched = touched || sum[1].m > 0;
-        if (!touched) continue;
-        stamp_[u] = epoch;
-        active.push_back(static_cast<int>(u));
-        for (std::size_t f = 0; f < F; ++f) {
-          NodalFields& to = f ? second_ : nodes_;
-          to.mass[u] = sum[f].m;
-          to.momentum[u] = Vec2(sum[f].px, sum[f].py);
-          to.force[u] = Vec2(sum[f].fx, sum[f].fy);
-          if constexpr (kCracks) to.displaced[u] = Vec2(sum[f].ux, sum[f].uy);
-        }
-      }
-    }
+    p2g_reduce<kCracks>(k);
   }
   active_.clear();
   for (const auto& part : thread_active_) active_.insert(active_.end(), part.begin(), part.end());
+}
+
+// The rows of nodes particles [begin, end) reach (particles are stored row
+// by row, so each thread's span is a band of the grid), zeroed in thread k's
+// accumulator; returns the band as node indices [first, last).
+template <bool kCracks>
+std::array<std::size_t, 2> Solver::p2g_zero_band(std::size_t k, std::size_t begin, std::size_t end) {
+  const auto& g = config_.grid;
+  constexpr std::size_t F = kCracks ? 2 : 1;  // fields per node in the accumulators
+  const std::size_t row = static_cast<std::size_t>(g.nodes_x());
+  auto& acc = thread_acc_[k];
+  double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
+  for (std::size_t p = begin; p < end; ++p) {
+    y_lo = std::min(y_lo, particles_.x[p].y());
+    y_hi = std::max(y_hi, particles_.x[p].y());
+  }
+  std::array<std::size_t, 2> span{0, 0};
+  if (begin < end) {
+    const auto row_of = [&](double y) { return static_cast<int>(std::floor((y - g.origin.y()) / g.h + 0.5)); };
+    // One row more each way than the stencil's reach, against rounding.
+    const int j0 = std::clamp(row_of(y_lo) - 2, 0, g.ny);
+    const int j1 = std::clamp(row_of(y_hi) + 2, 0, g.ny);
+    span = {static_cast<std::size_t>(j0) * row, static_cast<std::size_t>(j1 + 1) * row};
+    std::fill(acc.begin() + static_cast<std::ptrdiff_t>(span[0] * F),
+              acc.begin() + static_cast<std::ptrdiff_t>(span[1] * F), NodeAcc{});
+  }
+  return span;
+}
+
+// Mass, momentum, internal force (and, with cracks, the mass-weighted
+// displacement and each particle's side of the crack per node) of particles
+// [begin, end) into thread k's accumulator.
+template <bool kCracks>
+void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
+  const auto& g = config_.grid;
+  constexpr std::size_t F = kCracks ? 2 : 1;
+  auto& acc = thread_acc_[k];
+  for (std::size_t p = begin; p < end; ++p) {
+    const Vec2 x = particles_.x[p];
+    const Vec2 rel = x - g.origin;
+    const double lp = particles_.half_size[p];
+    const auto sx = ugimp_stencil(rel.x(), g.h, lp);
+    const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+    const double m = particles_.mass[p];
+    const Vec2 mv = m * particles_.v[p];
+    const Voigt& s = particles_.stress[p];
+    const double vol = particles_.volume[p];
+    bool near = false;
+    std::uint16_t sides = 0;
+    Vec2 mu = Vec2::Zero();
+    if constexpr (kCracks) {
+      near = near_crack(x);
+      if (near) sides = 1u << 15;
+      mu = m * particles_.displacement[p];
+    }
+    for (int b = 0; b < 3; ++b) {
+      const int j = sy.first + b;
+      if (j < 0 || j > g.ny) continue;
+      const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
+      for (int a = 0; a < 3; ++a) {
+        const int i = sx.first + a;
+        if (i < 0 || i > g.nx) continue;
+        const double w = sx.s[static_cast<std::size_t>(a)] * syb;
+        if (w == 0) continue;
+        const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
+        const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
+        const auto n = static_cast<std::size_t>(g.node(i, j));
+        std::size_t slot = n * F;
+        if constexpr (kCracks) {
+          if (near && field_of(x, g.position(static_cast<int>(n)))) {
+            ++slot;
+            sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
+          }
+        }
+        NodeAcc& f = acc[slot];
+        f.m += w * m;
+        f.px += w * mv.x();
+        f.py += w * mv.y();
+        // internal force -V sigma . grad S (s = xx, yy, xy, zz)
+        f.fx -= vol * (s[0] * gx + s[2] * gy);
+        f.fy -= vol * (s[2] * gx + s[1] * gy);
+        if constexpr (kCracks) {
+          f.ux += w * mu.x();
+          f.uy += w * mu.y();
+        }
+      }
+    }
+    if constexpr (kCracks) sides_[p] = sides;
+  }
+}
+
+// Thread k's slice of the nodes, summed over every thread's band, into the
+// fields (one field, or two with cracks), and the nodes it touched.
+template <bool kCracks>
+void Solver::p2g_reduce(std::size_t k) {
+  constexpr std::size_t F = kCracks ? 2 : 1;
+  const auto threads = thread_acc_.size();
+  const std::uint32_t epoch = epoch_;
+  // Reduce the spans into the fields: each thread a slice of the nodes.
+  std::size_t lo = std::numeric_limits<std::size_t>::max(), hi = 0;
+  for (const auto& sp : thread_span_) {
+    if (sp[0] < sp[1]) {
+      lo = std::min(lo, sp[0]);
+      hi = std::max(hi, sp[1]);
+    }
+  }
+  auto& active = thread_active_[k];
+  active.clear();
+  if (lo < hi) {
+    const std::size_t first = lo + (hi - lo) * k / threads, last = lo + (hi - lo) * (k + 1) / threads;
+    for (std::size_t u = first; u < last; ++u) {
+      NodeAcc sum[F] = {};
+      for (std::size_t t = 0; t < threads; ++t) {
+        const auto& sp = thread_span_[t];
+        if (u < sp[0] || u >= sp[1]) continue;
+        for (std::size_t f = 0; f < F; ++f) {
+          const NodeAcc& from = thread_acc_[t][u * F + f];
+          sum[f].m += from.m;
+          sum[f].px += from.px;
+          sum[f].py += from.py;
+          sum[f].fx += from.fx;
+          sum[f].fy += from.fy;
+          sum[f].ux += from.ux;
+          sum[f].uy += from.uy;
+        }
+      }
+      bool touched = sum[0].m > 0;
+      if constexpr (kCracks) touched = touched || sum[1].m > 0;
+      if (!touched) continue;
+      stamp_[u] = epoch;
+      active.push_back(static_cast<int>(u));
+      for (std::size_t f = 0; f < F; ++f) {
+        NodalFields& to = f ? second_ : nodes_;
+        to.mass[u] = sum[f].m;
+        to.momentum[u] = Vec2(sum[f].px, sum[f].py);
+        to.force[u] = Vec2(sum[f].fx, sum[f].fy);
+        if constexpr (kCracks) to.displaced[u] = Vec2(sum[f].ux, sum[f].uy);
+      }
+    }
+  }
 }
 
 template <bool kCracks>

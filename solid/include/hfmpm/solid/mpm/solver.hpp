@@ -142,6 +142,13 @@ class Solver {
   void find_edges();
   template <bool kCracks>
   void p2g();
+  // P2G's steps, each run by every thread (transfer.cpp).
+  template <bool kCracks>
+  std::array<std::size_t, 2> p2g_zero_band(std::size_t thread, std::size_t begin, std::size_t end);
+  template <bool kCracks>
+  void p2g_scatter(std::size_t thread, std::size_t begin, std::size_t end);
+  template <bool kCracks>
+  void p2g_reduce(std::size_t thread);
   void edge_loads();
   void grid_update(double dt);
   template <bool kCracks>
