@@ -44,8 +44,8 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
   for (std::size_t c = 0; c < config_.cracks.size(); ++c) {
     cracks_.emplace_back(static_cast<std::uint32_t>(c), config_.cracks[c]);
   }
-  nodes_.resize(n);
-  stamp_.assign(n, 0);
+  field0_.resize(n);
+  touched_in_.assign(n, 0);
   const int fields = cracked ? 2 : 1;  // an uncracked body never touches field 1
   for (int f = 0; f < fields; ++f) {
     velocity_[f].assign(n, Vec2::Zero());
@@ -56,13 +56,13 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
   thread_span_.assign(threads, {0, 0});
   thread_active_.resize(threads);
   for (auto& acc : thread_acc_) acc.resize(n * static_cast<std::size_t>(fields));
-  if (cracked) second_.resize(n);
+  if (cracked) field1_.resize(n);
   generate_particles();
   if (cracked) {
     particles_.displacement.assign(particles_.size(), Vec2::Zero());
     particles_.grad_u.assign(particles_.size(), Eigen::Matrix2d::Zero());
   }
-  if (cracked) sides_.assign(particles_.size(), 0);
+  if (cracked) stencil_fields_.assign(particles_.size(), 0);
   build_constraints();
   find_edges();
   double lightest = std::numeric_limits<double>::infinity();
@@ -152,8 +152,8 @@ void Solver::build_constraints() {
         mask = static_cast<std::uint8_t>((c.fix_x ? 1 : 0) | (c.fix_y ? 2 : 0));
       }
       if (mask) {
-        nodes_.fixed[n] |= mask;
-        if (cracked) second_.fixed[n] |= mask;
+        field0_.fixed[n] |= mask;
+        if (cracked) field1_.fixed[n] |= mask;
         ++count;
       }
     }
@@ -213,7 +213,7 @@ double Solver::strain_energy() const {
 
 void Solver::begin_step() {
   if (step_begun_) return;
-  ++epoch_;
+  ++transfer_;
   if (cracks_.empty()) {
     p2g<false>();
     edge_loads();
@@ -273,11 +273,11 @@ void Solver::edge_loads() {
         const int j = vertical_edge ? along.first + a : base + c;
         if (!g.inside(i, j)) continue;
         const auto node = static_cast<std::size_t>(g.node(i, j));
-        if (stamp_[node] != epoch_) continue;  // no mass there: nothing to push
+        if (touched_in_[node] != transfer_) continue;  // no mass there: nothing to push
         // Near a crack the force goes to the field of the particle's side.
         const bool other = !cracks_.empty() && near_crack(particles_.x[p]) &&
                            field_of(particles_.x[p], g.position(static_cast<int>(node)));
-        (other ? second_ : nodes_).force[node] += w * force;
+        (other ? field1_ : field0_).force[node] += w * force;
       }
     }
   };
@@ -320,7 +320,7 @@ void Solver::grid_update(double dt) {
   const double alpha = config_.damping.grid_alpha + feedback_alpha_;
   const int fields = cracks_.empty() ? 1 : 2;
   for (int field = 0; field < fields; ++field) {
-    const NodalFields& nodes = field ? second_ : nodes_;
+    const NodalFields& nodes = field ? field1_ : field0_;
     auto& velocity = velocity_[field];
     auto& acceleration = acceleration_[field];
     for (int n : active_) {

@@ -119,7 +119,7 @@ struct FaceShares {
 };
 
 FaceShares Solver::face_shares(const Crack& crack, std::size_t k, int side) const {
-  const NodalFields* fields[2] = {&nodes_, &second_};
+  const NodalFields* fields[2] = {&field0_, &field1_};
   FaceShares out;
   double total = 0;
   for_side_nodes(*this, config_.grid, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
@@ -135,7 +135,7 @@ FaceShares Solver::face_shares(const Crack& crack, std::size_t k, int side) cons
 void Solver::spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force) {
   const FaceShares s = face_shares(crack, k, side);
   for (int c = 0; c < s.count; ++c) {
-    (s.field[c] ? second_ : nodes_).force[static_cast<std::size_t>(s.node[c])] += s.share[c] * force;
+    (s.field[c] ? field1_ : field0_).force[static_cast<std::size_t>(s.node[c])] += s.share[c] * force;
   }
 }
 
@@ -161,7 +161,7 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
   if (!step_begun_) throw std::logic_error("Solver::face_response needs begin_step() first");
   const Crack& crack = cracks_.at(c);
   const std::size_t count = crack.size();
-  const NodalFields* fields[2] = {&nodes_, &second_};
+  const NodalFields* fields[2] = {&field0_, &field1_};
   const double alpha = config_.damping.grid_alpha + feedback_alpha_;
   auto key = [](int node, int field) { return static_cast<std::size_t>(node) * 2 + static_cast<std::size_t>(field); };
   auto tip = [&](std::size_t k) { return (k == 0 && crack.start_is_tip()) || (k + 1 == count && crack.end_is_tip()); };
@@ -277,13 +277,13 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
 // damped where the spring is stiff.
 // A fixed component of node u's field f stays fixed after a velocity change.
 void Solver::keep_fixed(std::size_t u, int f) {
-  const std::uint8_t fixed = (f ? second_ : nodes_).fixed[u];
+  const std::uint8_t fixed = (f ? field1_ : field0_).fixed[u];
   if (fixed & 1) velocity_[f][u].x() = acceleration_[f][u].x() = 0;
   if (fixed & 2) velocity_[f][u].y() = acceleration_[f][u].y() = 0;
 }
 
 void Solver::implicit_face_stiffness(double dt) {
-  const NodalFields* fields[2] = {&nodes_, &second_};
+  const NodalFields* fields[2] = {&field0_, &field1_};
   struct FaceNode {
     int node = -1;
     int field[2] = {-1, -1};  // [0] above, [1] below
@@ -292,7 +292,7 @@ void Solver::implicit_face_stiffness(double dt) {
     bool conflict = false;
   };
   std::vector<FaceNode> faces;
-  if (face_slot_.size() != nodes_.mass.size()) face_slot_.assign(nodes_.mass.size(), -1);
+  if (face_slot_.size() != field0_.mass.size()) face_slot_.assign(field0_.mass.size(), -1);
   for (const auto& crack : cracks_) {
     for (std::size_t k = 0; k < crack.size(); ++k) {
       const double s = crack.pressure_stiffness()[k];
@@ -342,7 +342,7 @@ void Solver::implicit_face_stiffness(double dt) {
 
 void Solver::move_crack_surfaces(double dt) {
   const auto& g = config_.grid;
-  const NodalFields* fields[2] = {&nodes_, &second_};
+  const NodalFields* fields[2] = {&field0_, &field1_};
   for (auto& crack : cracks_) {
     const std::size_t count = crack.size();
     std::vector<Vec2> momentum[2];
@@ -394,7 +394,7 @@ void Solver::contact(double dt) {
   const double contact_tolerance = 1e-6 * g.h;
   for (int n : active_) {
     const auto u = static_cast<std::size_t>(n);
-    const double m0 = nodes_.mass[u], m1 = second_.mass[u];
+    const double m0 = field0_.mass[u], m1 = field1_.mass[u];
     if (m0 <= min_mass_ || m1 <= min_mass_) continue;
     // Normal from the nearest crack particle; the side of the node from the
     // nearer of its two segments, with the same exact predicate and the same
@@ -429,10 +429,10 @@ void Solver::contact(double dt) {
     // Field 0 holds the node's own side; above if the node is left of the crack.
     const bool field0_above = orient2d(pl[seg], pl[seg + 1], x) >= 0;
     const Vec2 n_up = field0_above ? normal : Vec2(-normal);  // from field 1 towards field 0
-    const Vec2 p0 = dt > 0 ? Vec2(m0 * velocity_[0][u]) : nodes_.momentum[u];
-    const Vec2 p1 = dt > 0 ? Vec2(m1 * velocity_[1][u]) : second_.momentum[u];
+    const Vec2 p0 = dt > 0 ? Vec2(m0 * velocity_[0][u]) : field0_.momentum[u];
+    const Vec2 p1 = dt > 0 ? Vec2(m1 * velocity_[1][u]) : field1_.momentum[u];
     // Opening = (u_field0 - u_field1) . n_up; approach = (v_field0 - v_field1) . n_up < 0.
-    const double opening = (nodes_.displaced[u] / m0 - second_.displaced[u] / m1).dot(n_up);
+    const double opening = (field0_.displaced[u] / m0 - field1_.displaced[u] / m1).dot(n_up);
     const double approach = (p0 / m0 - p1 / m1).dot(n_up);
     // Touching counts as contact: a crack closed by an in-situ stress has
     // zero opening from the first step, and round-off (1e-16 m) must not
@@ -448,8 +448,8 @@ void Solver::contact(double dt) {
       keep_fixed(u, 0);
       keep_fixed(u, 1);
     } else {
-      nodes_.momentum[u] += dp;
-      second_.momentum[u] -= dp;
+      field0_.momentum[u] += dp;
+      field1_.momentum[u] -= dp;
     }
     ++contacts_;
   }

@@ -23,7 +23,7 @@ void Solver::p2g() {
   const auto threads = thread_acc_.size();
   const std::size_t count = particles_.size();
   if constexpr (kCracks) {
-    if (sides_.size() != count) sides_.assign(count, 0);
+    if (stencil_fields_.size() != count) stencil_fields_.assign(count, 0);
   }
 #pragma omp parallel num_threads(static_cast <int>(threads))
   {
@@ -124,7 +124,7 @@ void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
         }
       }
     }
-    if constexpr (kCracks) sides_[p] = sides;
+    if constexpr (kCracks) stencil_fields_[p] = sides;
   }
 }
 
@@ -134,7 +134,7 @@ template <bool kCracks>
 void Solver::p2g_reduce(std::size_t k) {
   constexpr std::size_t F = kCracks ? 2 : 1;
   const auto threads = thread_acc_.size();
-  const std::uint32_t epoch = epoch_;
+  const std::uint32_t epoch = transfer_;
   // Reduce the spans into the fields: each thread a slice of the nodes.
   std::size_t lo = std::numeric_limits<std::size_t>::max(), hi = 0;
   for (const auto& sp : thread_span_) {
@@ -166,10 +166,10 @@ void Solver::p2g_reduce(std::size_t k) {
       bool touched = sum[0].m > 0;
       if constexpr (kCracks) touched = touched || sum[1].m > 0;
       if (!touched) continue;
-      stamp_[u] = epoch;
+      touched_in_[u] = epoch;
       active.push_back(static_cast<int>(u));
       for (std::size_t f = 0; f < F; ++f) {
-        NodalFields& to = f ? second_ : nodes_;
+        NodalFields& to = f ? field1_ : field0_;
         to.mass[u] = sum[f].m;
         to.momentum[u] = Vec2(sum[f].px, sum[f].py);
         to.force[u] = Vec2(sum[f].fx, sum[f].fy);
@@ -195,7 +195,7 @@ void Solver::g2p(double dt) {
     const auto sx = ugimp_stencil(rel.x(), g.h, lp);
     const auto sy = ugimp_stencil(rel.y(), g.h, lp);
     std::uint16_t sides = 0;
-    if constexpr (kCracks) sides = sides_[p];  // the fields P2G found for its nodes
+    if constexpr (kCracks) sides = stencil_fields_[p];  // the fields P2G found for its nodes
     Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
     double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
     for (int b = 0; b < 3; ++b) {
@@ -293,7 +293,7 @@ std::size_t Solver::grid_bytes() const {
   auto fields = [&](const NodalFields& f) {
     return bytes(f.mass) + bytes(f.momentum) + bytes(f.force) + bytes(f.displaced) + bytes(f.fixed);
   };
-  std::size_t total = fields(nodes_) + fields(second_) + bytes(stamp_) + bytes(active_);
+  std::size_t total = fields(field0_) + fields(field1_) + bytes(touched_in_) + bytes(active_);
   for (int f = 0; f < 2; ++f) total += bytes(velocity_[f]) + bytes(acceleration_[f]);
   for (const auto& acc : thread_acc_) total += bytes(acc);
   return total;

@@ -94,7 +94,7 @@ class Solver {
   const Grid& grid() const { return config_.grid; }
   Particles& particles() { return particles_; }
   const Particles& particles() const { return particles_; }
-  const NodalFields& nodes() const { return nodes_; }
+  const NodalFields& nodes() const { return field0_; }
   // Particle p's Cauchy stress (Pa): the stored stress, plus its region's
   // initial stress when the particles carry changes (in_situ_reference).
   Voigt total_stress(std::size_t p) const;
@@ -109,7 +109,7 @@ class Solver {
   const std::vector<Crack>& cracks() const { return cracks_; }
   // The nodal fields of one side of a crack: field 1 holds the particles whose
   // line to the node crosses a crack (only near cracks).
-  const NodalFields& nodes(int field) const { return field ? second_ : nodes_; }
+  const NodalFields& nodes(int field) const { return field ? field1_ : field0_; }
   // Which field of `node` a point at `from` uses: 1 if the segment between
   // them crosses a crack an odd number of times, else 0.
   int field_of(const Vec2& from, const Vec2& node) const;
@@ -192,12 +192,15 @@ class Solver {
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
   Particles particles_;
-  NodalFields nodes_;   // reduced fields, field 0
-  NodalFields second_;  // field 1 (other side of a crack); sized only with cracks
+  // The grid's two velocity fields (CRAMP): field 0 holds every node's
+  // material on one side of a crack (and everywhere away from cracks), field
+  // 1 a node's material on the other side of a crack; sized only with cracks.
+  NodalFields field0_;
+  NodalFields field1_;
   std::vector<Crack> cracks_;
   // P2G's per-thread accumulators: one cache line per node and field
   // (index node * fields + field), over the span of nodes the thread's
-  // particles reach this step; the spans are reduced into nodes_ / second_.
+  // particles reach this step; the spans are reduced into field0_ / field1_.
   struct alignas(64) NodeAcc {
     double m, px, py, fx, fy, ux, uy, pad;
   };
@@ -206,15 +209,17 @@ class Solver {
   std::vector<std::vector<int>> thread_active_;
   // Per particle, cracks only, set by P2G for G2P: bit 15 = near a crack,
   // bit 3 b + a = node (a, b) of its 3 x 3 stencil is in field 1.
-  std::vector<std::uint16_t> sides_;
-  std::vector<std::uint32_t> stamp_;
+  std::vector<std::uint16_t> stencil_fields_;
+  // The P2G (its serial number, transfer_) that last gave each node mass: a
+  // node whose touched_in_ differs from transfer_ is empty this step.
+  std::vector<std::uint32_t> touched_in_;
   std::vector<int> active_;
   std::vector<Vec2> velocity_[2];      // new nodal velocity, per field and node
   std::vector<Vec2> acceleration_[2];  // nodal acceleration, per field and node
   std::vector<std::uint32_t> edges_[4];
   std::vector<double> lambda_, shear_, p_modulus_, density_;  // per material, density scaled
-  std::uint32_t epoch_ = 0;
-  bool step_begun_ = false;  // begin_step() ran; step() finishes it
+  std::uint32_t transfer_ = 0;                                // serial number of the current P2G (touched_in_)
+  bool step_begun_ = false;                                   // begin_step() ran; step() finishes it
   double t_ = 0;
   std::uint64_t steps_ = 0;
   std::vector<int> face_slot_;  // scratch of implicit_face_stiffness: node -> entry, -1
