@@ -70,35 +70,22 @@ def set_args(sets):
     return out
 
 
-def parse_textproto(text):
-    """`hfmpm validate`'s canonical text format -> nested dicts; every key maps to a list."""
-    root, stack = {}, []
-    stack.append(root)
-    for raw in text.splitlines():
-        line = raw.strip()
-        if not line or line.startswith("#"):
-            continue
-        if line == "}":
-            stack.pop()
-            continue
-        if line.endswith("{"):
-            child = {}
-            stack[-1].setdefault(line[:-1].strip(), []).append(child)
-            stack.append(child)
-            continue
-        key, _, val = line.partition(":")
-        val = val.strip()
-        if val.startswith('"') and val.endswith('"'):
-            val = val[1:-1]
-        elif val in ("true", "false"):
-            val = val == "true"
-        else:
-            try:
-                val = float(val)
-            except ValueError:
-                pass  # an enum name
-        stack[-1].setdefault(key.strip(), []).append(val)
-    return root
+def scene_tree(value):
+    """`hfmpm validate --json`'s scene -> nested dicts in which every key maps to a list (a
+    repeated field's elements, or the one value), numbers as floats (JSON carries 64-bit
+    integers as strings), enums as their names."""
+    if isinstance(value, dict):
+        return {k: [scene_tree(x) for x in v] if isinstance(v, list) else [scene_tree(v)] for k, v in value.items()}
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, str):
+        try:
+            return float(value)  # an int64 as a string; names and enum values stay strings
+        except ValueError:
+            return value
+    return value
 
 
 def get(tree, path, default=None, index=0):
@@ -121,10 +108,10 @@ def get_all(tree, path):
 
 def validate(exe, scene, sets):
     """(scene tree with the overrides applied, None) or (None, hfmpm's message)."""
-    r = subprocess.run([exe, "validate", scene] + set_args(sets), capture_output=True, text=True, cwd=ROOT)
+    r = subprocess.run([exe, "validate", scene, "--json"] + set_args(sets), capture_output=True, text=True, cwd=ROOT)
     if r.returncode != 0:
         return None, (r.stderr.strip() or r.stdout.strip() or f"hfmpm validate exited {r.returncode}")
-    return parse_textproto(r.stdout), None
+    return scene_tree(json.loads(r.stdout)), None
 
 
 def read_json(path):
@@ -384,8 +371,7 @@ def main():
     if err:
         die(f"{scene} does not validate: {err}")
     p = kgd_params(tree)
-    sys.path.insert(0, TOOLS)
-    import kgd_plot
+    import kgd_plot  # beside this file: Python puts a script's folder first on its path
     t_end = get(tree, "time.end_s")
     L_end = kgd_plot.vertices(p["E"], p["nu"], p["mu"], p["Q"], p["KIc"], t_end - p["t0"])[0][0]
     L0, h0 = get(tree, "solid.mpm.cracks.x_m", index=1), get(tree, "solid.mpm.cell_size_m")

@@ -32,8 +32,7 @@ import re
 import signal
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from kgd_sweep import ROOT, die, hfmpm_path, on_sigterm, run_case, stop_all  # noqa: E402
+from kgd_sweep import ROOT, die, hfmpm_path, on_sigterm, run_case, stop_all
 
 
 def layers_of(scene_text):

@@ -50,8 +50,7 @@ import signal
 import sys
 from concurrent.futures import ThreadPoolExecutor
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from kgd_sweep import ROOT, die, get, get_all, hfmpm_path, on_sigterm, pick, run_case, stop_all, validate  # noqa: E402
+from kgd_sweep import ROOT, die, get, get_all, hfmpm_path, on_sigterm, pick, run_case, stop_all, validate
 
 SCENE = "scenarios/stability-kgd.scene"
 LAYERED = "scenarios/layered.scene"

@@ -1,6 +1,7 @@
 // hfmpm: run a scene (coupler + sides), run a coupler that waits for sides
 // started by hand, or validate a scene. Thin: parse, load, run, report.
 #include <google/protobuf/text_format.h>
+#include <google/protobuf/util/json_util.h>
 
 #include <filesystem>
 #include <iomanip>
@@ -33,8 +34,9 @@ constexpr const char* kUsage = R"(usage:
       Write a CURVE key pair for the coupler and one for the sides: DIR/coupler.keys
       and DIR/side.keys (0600, DIR 0700). A coupler on tcp admits only sides that
       hold side.keys; nothing secret goes into run.json or onto a command line.
-  hfmpm validate SCENE [--set KEY=VALUE]...
-      Check SCENE and print it with every default filled in.
+  hfmpm validate SCENE [--set KEY=VALUE]... [--json]
+      Check SCENE and print it with every default filled in (--json: as JSON, for
+      scripts; every run also writes it to OUT/scene.json).
 
 options:
   --out DIR            output directory (default: hfmpm-out/SCENE_NAME)
@@ -93,6 +95,7 @@ int keygen(const std::vector<std::string>& args) {
 int run(const std::string& command, const std::vector<std::string>& args) {
   std::string scene_path, out, bind;
   std::vector<std::string> overrides;
+  bool json = false;  // validate: print JSON
   coupling::RunOptions options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
@@ -111,6 +114,8 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       bind = value();
     else if (arg == "--quiet")
       options.progress = false;
+    else if (arg == "--json")
+      json = true;
     else if (arg == "--keys")
       options.keys_file = value();
     else if (arg == "--insecure-tcp")
@@ -133,8 +138,20 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   }
   if (scene_path.empty()) throw UsageError("no scene file given");
   const scene::Scene scene = coupling::load_scene(scene_path, overrides);
+  if (json && command != "validate") throw UsageError("--json is for 'hfmpm validate'");
   if (command == "validate") {
     const scene::Scene filled = coupling::with_defaults(scene);
+    if (json) {  // for scripts: the same, as Protobuf's JSON with the schema's field names
+      std::string text;
+      google::protobuf::util::JsonPrintOptions print;
+      print.add_whitespace = true;
+      print.preserve_proto_field_names = true;
+      if (!google::protobuf::util::MessageToJsonString(filled, &text, print).ok()) {
+        throw std::runtime_error("cannot print the scene as JSON");
+      }
+      std::cout << text;
+      return 0;
+    }
     std::string text;
     google::protobuf::TextFormat::PrintToString(filled, &text);
     std::cout << "# " << scene_path << ": valid\n" << text;
