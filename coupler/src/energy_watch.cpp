@@ -33,9 +33,13 @@ std::optional<std::string> EnergyWatch::update(double t, std::uint64_t step, con
       << bound_ << " x, coupling.energy_bound). The inlet pressure is " << fluid.inlet_pressure
       << " Pa, the fluid volume " << fluid.fluid_volume << " m^2 against " << fluid.injected_volume
       << " m^2 injected, the mouth opening " << solid.mouth_opening
-      << " m. The coupled step is unstable: exchange every step (coupling.exchange_interval: 1), lower "
-         "time.safety_factor or solid.mpm.cfl, or soften the fluid (fluid.mpm.bulk_modulus_pa). A scene whose "
-         "tractions do work of their own can raise coupling.energy_bound or set it to 0 (no check).";
+      << " m. Likely sources: (1) the coupled step: exchange every step (coupling.exchange_interval: 1), "
+         "lower time.safety_factor or solid.mpm.cfl, use coupling.scheme: IMPLICIT, or soften the fluid "
+         "(fluid.mpm.bulk_modulus_pa); (2) in-situ shear released where a crack opens or turns through a region "
+         "whose initial_stress has shear or unequal normal stresses (that stress does work as the crack opens: "
+         "not an instability, raise coupling.energy_bound); (3) a crack crossing another crack or running out "
+         "of the body (check the paths in solid.h5). A scene whose tractions do work of their own can raise "
+         "coupling.energy_bound or set it to 0 (no check).";
   return out.str();
 }
 
