@@ -11,7 +11,7 @@ mode=${1:-run}
 case "$mode" in run|test|build) ;; *) echo "usage: $0 run|test|build" >&2; exit 2 ;; esac
 
 packages=(build-essential cmake pkg-config libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
-          libeigen3-dev libhdf5-dev libgtest-dev libgmock-dev python3
+          libeigen3-dev libhdf5-dev libgtest-dev libgmock-dev libcli11-dev python3
           python3-numpy python3-matplotlib python3-h5py)  # the last three: tools/kgd_plot.py
 # The test mode also checks format and lint (tools/lint.sh) and runs across network namespaces.
 [ "$mode" = test ] && packages+=(clang-format clang-tidy iproute2)  # iproute2: tools/netns_run.sh

@@ -1,28 +1,11 @@
+// The command line of every side program (hfmpm-solid, hfmpm-fluid and the
+// stand-ins), parsed with CLI11: typed values, ranges, --help.
+#include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "hfmpm/coupling/side_runtime.hpp"
 
 namespace hfmpm::coupling {
-namespace {
-
-void usage(std::ostream& out, const std::string& program, protocol::Role role) {
-  out << "usage: " << program << " --connect ENDPOINT [options]\n"
-      << "A " << proto::role_name(role) << " side of hfmpm (protocol version " << proto::kProtocolVersion
-      << "). Normally started by the coupler; start it by hand to join a coupler\n"
-      << "started with 'hfmpm coupler SCENE --bind ENDPOINT', e.g. on another host.\n\n"
-      << "  --connect ENDPOINT       the coupler's control endpoint (tcp://HOST:PORT, ipc://PATH)\n"
-      << "  --out DIR                where this side writes its files (default: the coupler's)\n"
-      << "  --advertise-host HOST    tcp: the host name the other side reaches this one at\n"
-      << "  --keys FILE              tcp: the sides' CURVE key file (side.keys from 'hfmpm keygen DIR');\n"
-      << "                           a coupler on tcp admits no side without it (unless --insecure-tcp)\n"
-      << "  --welcome-timeout S      seconds to wait for the coupler's answer (default 60)\n"
-      << "  --fault KIND@STEP        test hook: exit|crash|hang|freeze|garbage|nan at STEP\n"
-      << "  --protocol-version N     test hook: claim protocol version N\n"
-      << "  --scene-schema-version N test hook: claim scene schema version N (0: an older side)\n"
-      << "  --help                   this text\n";
-}
-
-}  // namespace
 
 int side_main(int argc, char** argv, protocol::Role role, const std::string& implementation,
               const std::vector<std::string>& capabilities,
@@ -32,41 +15,46 @@ int side_main(int argc, char** argv, protocol::Role role, const std::string& imp
   options.role = role;
   options.implementation = implementation;
   options.capabilities = capabilities;
+
+  CLI::App app("A " + std::string(proto::role_name(role)) + " side of hfmpm (protocol version " +
+                   std::to_string(proto::kProtocolVersion) +
+                   "). Normally started by the coupler; start it by hand to join a coupler started with\n"
+                   "'hfmpm coupler SCENE --bind ENDPOINT', e.g. on another host.",
+               program);
+  std::string keys, fault;
+  app.add_option("--connect", options.control_endpoint, "the coupler's control endpoint (tcp://HOST:PORT, ipc://PATH)")
+      ->required()
+      ->type_name("ENDPOINT");
+  app.add_option("--out", options.output_dir, "where this side writes its files (default: the coupler's)")
+      ->type_name("DIR");
+  app.add_option("--advertise-host", options.advertise_host, "tcp: the host name the other side reaches this one at")
+      ->type_name("HOST");
+  app.add_option("--keys", keys,
+                 "tcp: the sides' CURVE key file (side.keys from 'hfmpm keygen DIR'); a coupler on tcp admits no "
+                 "side without it (unless --insecure-tcp)")
+      ->type_name("FILE");
+  app.add_option("--welcome-timeout", options.welcome_timeout_s,
+                 "seconds to wait for the coupler's answer to Hello, 0.001 to 1e6 (default 60)")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->type_name("S");
+  app.add_option("--fault", fault, "test hook: exit|crash|hang|freeze|garbage|nan at STEP")->type_name("KIND@STEP");
+  app.add_option("--protocol-version", options.protocol_version, "test hook: claim protocol version N in Hello")
+      ->type_name("N");
+  app.add_option("--scene-schema-version", options.scene_schema_version,
+                 "test hook: claim scene schema version N in Hello (0: a side built before them)")
+      ->type_name("N");
   try {
-    for (int i = 1; i < argc; ++i) {
-      const std::string arg = argv[i];
-      auto value = [&]() -> std::string {
-        if (i + 1 >= argc) throw InputError("option " + arg + " needs a value");
-        return argv[++i];
-      };
-      if (arg == "--help" || arg == "-h") {
-        usage(std::cout, program, role);
-        return 0;
-      } else if (arg == "--connect") {
-        options.control_endpoint = value();
-      } else if (arg == "--out") {
-        options.output_dir = value();
-      } else if (arg == "--keys") {
-        try {
-          options.curve = read_side_key_file(value());
-        } catch (const std::runtime_error& e) {
-          throw InputError(e.what());
-        }
-      } else if (arg == "--advertise-host") {
-        options.advertise_host = value();
-      } else if (arg == "--welcome-timeout") {
-        options.welcome_timeout_s = std::stod(value());
-      } else if (arg == "--fault") {
-        options.fault = Fault::parse(value());
-      } else if (arg == "--protocol-version") {
-        options.protocol_version = static_cast<std::uint32_t>(std::stoul(value()));
-      } else if (arg == "--scene-schema-version") {
-        options.scene_schema_version = static_cast<std::uint32_t>(std::stoul(value()));
-      } else {
-        throw InputError("unknown option '" + arg + "'; see --help");
-      }
-    }
-    if (options.control_endpoint.empty()) throw InputError("--connect ENDPOINT is required; see --help");
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::cerr << program << ": " << e.what() << "; see --help\n";
+    return kSideInput;
+  }
+  try {
+    if (!keys.empty()) options.curve = read_side_key_file(keys);
+    if (!fault.empty()) options.fault = Fault::parse(fault);
     if (options.control_endpoint.rfind("tcp://", 0) == 0 && !options.curve) {
       std::cerr << program << ": note: no --keys: joining over plain tcp; a coupler that requires CURVE (the "
                 << "default on tcp) will not hear this side\n";
