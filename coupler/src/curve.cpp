@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -92,6 +93,24 @@ std::string need(const std::map<std::string, std::string>& keys, const std::stri
   return it->second;
 }
 
+// The keys a file of kind `which` must hold, read into their members.
+CurveKeys read_keys(const std::string& path, std::initializer_list<std::string CurveKeys::*> members,
+                    const std::string& which) {
+  static const std::pair<std::string CurveKeys::*, const char*> kNames[] = {
+      {&CurveKeys::server_public, "server_public"},
+      {&CurveKeys::server_secret, "server_secret"},
+      {&CurveKeys::client_public, "client_public"},
+      {&CurveKeys::client_secret, "client_secret"}};
+  const auto keys = read_key_file(path);
+  CurveKeys out;
+  for (const auto member : members) {
+    for (const auto& [m, name] : kNames) {
+      if (m == member) out.*member = need(keys, name, path, which);
+    }
+  }
+  return out;
+}
+
 std::string z85_to_binary(const std::string& key) {
   std::string bytes(32, '\0');
   zmq_z85_decode(reinterpret_cast<std::uint8_t*>(bytes.data()), key.c_str());
@@ -130,21 +149,13 @@ void write_side_key_file(const std::string& path, const CurveKeys& keys) {
 }
 
 CurveKeys read_coupler_key_file(const std::string& path) {
-  const auto keys = read_key_file(path);
-  CurveKeys out;
-  out.server_public = need(keys, "server_public", path, "coupler.keys");
-  out.server_secret = need(keys, "server_secret", path, "coupler.keys");
-  out.client_public = need(keys, "client_public", path, "coupler.keys");
-  return out;
+  return read_keys(path, {&CurveKeys::server_public, &CurveKeys::server_secret, &CurveKeys::client_public},
+                   "coupler.keys");
 }
 
 CurveKeys read_side_key_file(const std::string& path) {
-  const auto keys = read_key_file(path);
-  CurveKeys out;
-  out.server_public = need(keys, "server_public", path, "side.keys");
-  out.client_public = need(keys, "client_public", path, "side.keys");
-  out.client_secret = need(keys, "client_secret", path, "side.keys");
-  return out;
+  return read_keys(path, {&CurveKeys::server_public, &CurveKeys::client_public, &CurveKeys::client_secret},
+                   "side.keys");
 }
 
 void make_curve_server(zmq::socket_t& socket, const std::string& secret_key) {

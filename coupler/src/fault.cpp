@@ -1,7 +1,13 @@
-// The --fault test hook's parser (KIND@STEP).
+// The --fault test hook: its parser (KIND@STEP) and its action.
+#include <chrono>
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
 #include <string>
+#include <thread>
 
 #include "hfmpm/coupling/side_runtime.hpp"
+#include "side_checks.hpp"
 
 namespace hfmpm::coupling {
 
@@ -34,6 +40,35 @@ Fault Fault::parse(const std::string& text) {
     throw InputError("--fault '" + text + "': expected KIND@STEP with STEP a positive integer");
   }
   return fault;
+}
+
+bool act_on_fault(const Fault& fault, std::uint64_t step, const std::string& role, zmq::socket_t& control,
+                  zmq::socket_t* data) {
+  if (fault.kind == Fault::Kind::None || fault.step != step) return false;
+  std::cerr << role << ": injecting fault at step " << step << "\n";
+  switch (fault.kind) {
+    case Fault::Kind::Exit:
+      std::_Exit(7);
+    case Fault::Kind::Crash:
+      std::abort();
+    case Fault::Kind::Hang:
+      while (true) std::this_thread::sleep_for(std::chrono::seconds(1));
+    case Fault::Kind::Freeze:
+      std::raise(SIGSTOP);
+      return false;
+    case Fault::Kind::Garbage: {
+      static constexpr char kGarbage[] = "\xff\x01garbage\x00\x7f not an envelope";
+      const std::string garbage(kGarbage, sizeof(kGarbage) - 1);
+      (void)control.send(zmq::buffer(garbage), zmq::send_flags::none);
+      if (data) (void)data->send(zmq::buffer(garbage), zmq::send_flags::none);
+      return false;
+    }
+    case Fault::Kind::NaN:
+      return true;
+    case Fault::Kind::None:
+      break;
+  }
+  return false;
 }
 
 }  // namespace hfmpm::coupling

@@ -49,6 +49,9 @@ void check_time_function(Checker& c, const std::string& key, const scene::TimeFu
                          const std::string& unit);
 // Rules for solid.mpm (scene_validate_mpm.cpp).
 void check_mpm_solid(Checker& c, const scene::MpmSolid& m);
+// scene_validate_geometry.cpp
+void check_crack_geometry(Checker& c, const scene::MpmSolid& m);
+void check_regions_in_grid(Checker& c, const scene::MpmSolid& m);
 // The MPM solid's stable step, cfl h / c_p of its fastest material (density
 // scaled) as the solid computes it; NaN if the values needed are invalid.
 double mpm_solid_stable_dt(const scene::MpmSolid& m);

@@ -19,6 +19,7 @@
 #include "heartbeat.hpp"
 #include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "side_checks.hpp"
 
 namespace hfmpm::coupling {
 namespace {
@@ -279,22 +280,7 @@ class SideRuntime {
   }
 
   void check_command(const protocol::StepCommand& command) const {
-    if (command.first_step() != step_) {
-      throw proto::ProtocolError("StepCommand starts at step " + std::to_string(command.first_step()) +
-                                 " but this side is at step " + std::to_string(step_));
-    }
-    if (!(std::isfinite(command.dt()) && command.dt() > 0)) {
-      throw proto::ProtocolError("StepCommand dt = " + std::to_string(command.dt()) + " s; dt must be finite and > 0");
-    }
-    if (command.num_steps() == 0 || (has_peer_ && command.num_steps() % exchange_interval_ != 0)) {
-      throw proto::ProtocolError("StepCommand num_steps = " + std::to_string(command.num_steps()) +
-                                 "; it must be >= 1 and a multiple of the exchange interval " +
-                                 std::to_string(exchange_interval_));
-    }
-    if (std::abs(command.t() - t_) > 1e-9 * std::max(1.0, std::abs(t_))) {
-      throw proto::ProtocolError("StepCommand t = " + std::to_string(command.t()) +
-                                 " s but this side is at t = " + std::to_string(t_) + " s");
-    }
+    check_step_command(command, step_, t_, has_peer_ ? exchange_interval_ : 1);
   }
 
   void execute(const protocol::StepCommand& command) {
@@ -423,55 +409,12 @@ class SideRuntime {
   }
 
   void check_frame(const protocol::Envelope& envelope, std::uint64_t expected) const {
-    const std::string from = "the " + peer_ + " side";
-    if (!envelope.has_data()) {
-      throw proto::ProtocolError("unexpected " + std::string(proto::body_name(envelope)) + " message from " + from +
-                                 " on the data plane; only DataFrame is allowed there");
-    }
-    const auto& frame = envelope.data();
-    const bool right_payload = options_.role == protocol::SOLID ? frame.has_fluid() : frame.has_crack();
-    if (!right_payload) {
-      throw proto::ProtocolError("DataFrame from " + from + " carries " +
-                                 (frame.has_crack()   ? "a CrackState"
-                                  : frame.has_fluid() ? "a FluidState"
-                                                      : "nothing") +
-                                 "; a " + peer_ + " side sends " +
-                                 (options_.role == protocol::SOLID ? "FluidState" : "CrackState"));
-    }
-    if (frame.step() != expected) {
-      throw proto::ProtocolError("DataFrame from " + from + " is for step " + std::to_string(frame.step()) +
-                                 " but step " + std::to_string(expected) + " was due");
-    }
+    check_data_frame(envelope, options_.role, expected);
   }
 
   // ---------------------------------------------------------------- faults
   void inject_fault(std::uint64_t step) {
-    const auto& fault = options_.fault;
-    if (fault.kind == Fault::Kind::None || fault.step != step) return;
-    std::cerr << role_ << ": injecting fault at step " << step << "\n";
-    switch (fault.kind) {
-      case Fault::Kind::Exit:
-        std::_Exit(7);
-      case Fault::Kind::Crash:
-        std::abort();
-      case Fault::Kind::Hang:
-        while (true) std::this_thread::sleep_for(std::chrono::seconds(1));
-      case Fault::Kind::Freeze:
-        std::raise(SIGSTOP);
-        break;
-      case Fault::Kind::Garbage: {
-        static constexpr char kGarbage[] = "\xff\x01garbage\x00\x7f not an envelope";
-        const std::string garbage(kGarbage, sizeof(kGarbage) - 1);
-        (void)control_.send(zmq::buffer(garbage), zmq::send_flags::none);
-        if (data_) (void)data_->send(zmq::buffer(garbage), zmq::send_flags::none);
-        break;
-      }
-      case Fault::Kind::NaN:
-        poison_next_frame_ = true;
-        break;
-      case Fault::Kind::None:
-        break;
-    }
+    if (act_on_fault(options_.fault, step, role_, control_, data_ ? &*data_ : nullptr)) poison_next_frame_ = true;
   }
 
  public:
@@ -496,9 +439,8 @@ class SideRuntime {
   microseconds heartbeat_timeout_{3'000'000};
   microseconds spin_{0};
   std::uint32_t exchange_interval_ = 1;
-  bool waits_first_ = false;
-  double publish_compute_s_ = 0;  // s in model_.publish since the last StepReport  // this side consumes the peer's
-                                  // frame of a step before stepping
+  bool waits_first_ = false;      // this side consumes the peer's frame of a step before stepping
+  double publish_compute_s_ = 0;  // s in model_.publish since the last StepReport
   bool has_peer_ = false;
   bool poison_next_frame_ = false;
   bool set_up_ = false;

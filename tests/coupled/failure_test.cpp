@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <memory>
 #include <zmq.hpp>
 
 #include "coupled_support.hpp"
@@ -218,19 +219,42 @@ TEST(Failure, NoSideJoinsWithinTheJoinTimeout) {
   EXPECT_NE(result.err.find("solid, fluid"), std::string::npos) << result.err;
 }
 
+// The stand-in scene run once without strangers, and a coupler on plain tcp
+// (--insecure-tcp, so strangers reach it) waiting for sides started by hand.
+struct StrangerRun {
+  std::string reference, out, endpoint;
+  std::unique_ptr<Process> coupler;
+};
+
+StrangerRun start_insecure_coupler(const std::string& name) {
+  StrangerRun r;
+  r.reference = scratch_dir(name + "-ref");
+  EXPECT_EQ(run_scene(prescribed_scene(), r.reference, {}).exit_code, 0);
+  r.out = scratch_dir(name);
+  const std::string scene = r.out + "/scene.scene";
+  write_file(scene, prescribed_scene());
+  r.coupler = std::make_unique<Process>(std::vector<std::string>{
+      bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--insecure-tcp", "--out", r.out, "--quiet"});
+  r.endpoint = wait_for_endpoint(r.out + "/run.json", 10);
+  return r;
+}
+
+// The real sides join; the run completes with the history of the run without strangers.
+void join_sides_and_expect_the_same_run(StrangerRun& r) {
+  Process solid(
+      {bin("hfmpm-prescribed-solid"), "--connect", r.endpoint, "--out", r.out, "--advertise-host", "127.0.0.1"});
+  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", r.endpoint, "--out", r.out});
+  ASSERT_TRUE(r.coupler->wait(60));
+  EXPECT_EQ(r.coupler->exit_code(), 0) << r.coupler->err();
+  expect_same_history(read_csv(r.reference + "/history.csv"), read_csv(r.out + "/history.csv"));
+}
+
 // Plain tcp (--insecure-tcp): bytes that are not ZMTP on the coupler's tcp
 // port, and a ZeroMQ peer that is neither side sending garbage: both are
 // refused and the run goes on unchanged.
 TEST(Failure, StrangersOnTheControlPortAreIgnored) {
-  const auto reference = scratch_dir("strangers-ref");
-  ASSERT_EQ(run_scene(prescribed_scene(), reference, {}).exit_code, 0);
-
-  const auto out = scratch_dir("strangers");
-  const std::string scene = out + "/scene.scene";
-  write_file(scene, prescribed_scene());
-  Process coupler(
-      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--insecure-tcp", "--out", out, "--quiet"});
-  const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
+  auto run = start_insecure_coupler("strangers");
+  const std::string& endpoint = run.endpoint;
   ASSERT_FALSE(endpoint.empty());
   const int port = std::stoi(endpoint.substr(endpoint.rfind(':') + 1));
 
@@ -250,14 +274,10 @@ TEST(Failure, StrangersOnTheControlPortAreIgnored) {
   stranger.connect(endpoint);
   stranger.send(zmq::str_buffer("\x08\xff\xff garbage"), zmq::send_flags::none);
 
-  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--out", out, "--advertise-host", "127.0.0.1"});
-  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", out});
-  ASSERT_TRUE(coupler.wait(60));
+  join_sides_and_expect_the_same_run(run);
   close(raw);
-  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
-  EXPECT_NE(read_file(out + "/coupler.log").find("ignored a message from an unknown peer 'intruder'"),
+  EXPECT_NE(read_file(run.out + "/coupler.log").find("ignored a message from an unknown peer 'intruder'"),
             std::string::npos);
-  expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
 }
 
 // SIGINT, SIGTERM and SIGHUP stop `hfmpm run` at its next control round: the
@@ -400,14 +420,8 @@ TEST(Failure, TcpCouplerNeedsKeysOrInsecureTcp) {
 // above the coupler's message limit (4 MiB) is disconnected by ZeroMQ before
 // the frame is kept or delivered; the run goes on and is unchanged.
 TEST(Failure, OversizedFrameFromAStrangerIsDropped) {
-  const auto reference = scratch_dir("oversized-ref");
-  ASSERT_EQ(run_scene(prescribed_scene(), reference, {}).exit_code, 0);
-  const auto out = scratch_dir("oversized");
-  const std::string scene = out + "/scene.scene";
-  write_file(scene, prescribed_scene());
-  Process coupler(
-      {bin("hfmpm"), "coupler", scene, "--bind", "tcp://127.0.0.1:*", "--insecure-tcp", "--out", out, "--quiet"});
-  const std::string endpoint = wait_for_endpoint(out + "/run.json", 10);
+  auto run = start_insecure_coupler("oversized");
+  const std::string& endpoint = run.endpoint;
   ASSERT_FALSE(endpoint.empty());
   zmq::context_t context;
   zmq::socket_t stranger(context, zmq::socket_type::dealer);
@@ -418,11 +432,7 @@ TEST(Failure, OversizedFrameFromAStrangerIsDropped) {
   stranger.send(zmq::buffer(big), zmq::send_flags::none);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   stranger.close();
-  Process solid({bin("hfmpm-prescribed-solid"), "--connect", endpoint, "--out", out, "--advertise-host", "127.0.0.1"});
-  Process fluid({bin("hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", out});
-  ASSERT_TRUE(coupler.wait(60));
-  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
-  expect_same_history(read_csv(reference + "/history.csv"), read_csv(out + "/history.csv"));
+  join_sides_and_expect_the_same_run(run);
 }
 
 // With --transport inproc the sides are threads of the coupler's process:

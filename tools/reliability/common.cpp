@@ -6,6 +6,8 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <filesystem>
+#include <iostream>
 
 #include <algorithm>
 #include <cstring>
@@ -186,6 +188,17 @@ std::string fixed(double value, int decimals) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(decimals) << value;
   return out.str();
+}
+
+int conclude(bool ok, const std::string& root, const CommonOptions& options) {
+  std::cout << (ok ? "OK" : "PROBLEMS FOUND") << "\n";
+  std::error_code ec;
+  if (ok && !options.keep) {
+    std::filesystem::remove_all(root, ec);
+  } else {
+    std::cout << "outputs kept in " << root << "\n";
+  }
+  return ok ? 0 : 1;
 }
 
 }  // namespace hfmpm::reliability

@@ -97,4 +97,8 @@ int kill_command(int trials, const CommonOptions& options);
 int fuzz_command(std::uint64_t messages, const CommonOptions& options);
 int bad_scenes_command(const CommonOptions& options);
 
+// The end of a command: prints OK or PROBLEMS FOUND, removes `root` when all
+// is well (unless --keep), else says where the outputs are; the exit status.
+int conclude(bool ok, const std::string& root, const CommonOptions& options);
+
 }  // namespace hfmpm::reliability

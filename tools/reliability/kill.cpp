@@ -252,14 +252,7 @@ int kill_command(int trials, const CommonOptions& options) {
             << "  left behind by a SIGKILLed coupler (removed by this tool): ipc directories " << ipc_left
             << ", CURVE key directories " << keys_left << "\n";
   const bool ok = detected == kills && kills > 0 && hangs == 0 && orphans == 0 && unreadable == 0;
-  std::cout << (ok ? "OK" : "PROBLEMS FOUND") << "\n";
-  std::error_code ec;
-  if (ok && !options.keep) {
-    fs::remove_all(root, ec);
-  } else {
-    std::cout << "outputs kept in " << root << "\n";
-  }
-  return ok ? 0 : 1;
+  return conclude(ok, root, options);
 }
 
 }  // namespace hfmpm::reliability
