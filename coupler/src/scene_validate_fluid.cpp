@@ -116,7 +116,9 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
         c.positive(key + "initial_fill.front_m", fill.front_m(), "m");
       }
     }
-    c.non_negative(key + "initial_fill.pressure_pa", fill.pressure_pa(), "Pa");
+    const double K = f.bulk_modulus_pa() > 0 ? f.bulk_modulus_pa() : kInf;
+    c.range(key + "initial_fill.pressure_pa", fill.pressure_pa(), 0, K, false,
+            "Pa, at most fluid.mpm.bulk_modulus_pa (no liquid's equation of state holds beyond)");
   }
 }
 

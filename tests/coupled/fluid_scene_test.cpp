@@ -221,6 +221,7 @@ TEST(FluidScene, BadFluidSettingsAreRefused) {
       {"fluid.mpm.lag=LAG_UNSPECIFIED", "fluid.mpm.lag", "ZERO_PRESSURE, FRONT_PRESSURE or FIXED_PRESSURE"},
       {"fluid.mpm.lag_pressure_pa=-1", "fluid.mpm.lag_pressure_pa", ">= 0"},
       {"fluid.mpm.merge_fraction=2", "fluid.mpm.merge_fraction", ">= 0 and < 2"},
+      {"fluid.mpm.initial_fill.pressure_pa=3e9", "fluid.mpm.initial_fill.pressure_pa", "bulk_modulus_pa"},
   };
   for (const auto& c : cases) {
     const auto result = run({bin("hfmpm"), "validate", source("scenarios/channel.scene"), "--set", c.set}, 30);

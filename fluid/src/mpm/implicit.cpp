@@ -362,6 +362,7 @@ void FluidSolver::step_implicit(double dt) {
         solved_ = P;
         // Commit: the explicit update of step() under the solved pressures.
         for (std::size_t p = 0; p < np; ++p) particles_.pressure[p] = trial.pp[p];
+        check_compression();
         faces = trial.nodal;
         force_ = trial.force;
         grid_update(dt);

@@ -17,8 +17,11 @@ void FluidSolver::fill(double front, double pressure) {
     out << "fluid: fill front " << front << " m must lie in (0, " << grid_.length() << "] m (the crack length)";
     throw std::invalid_argument(out.str());
   }
-  if (!(pressure >= 0) || !std::isfinite(pressure)) {
-    throw std::invalid_argument("fluid: fill pressure must be finite and >= 0 Pa, got " + std::to_string(pressure));
+  if (!(pressure >= 0) || !(pressure <= config_.bulk_modulus)) {
+    std::ostringstream out;
+    out << "fluid: fill pressure must lie in [0, " << config_.bulk_modulus
+        << "] Pa (at most the bulk modulus: no liquid's equation of state holds beyond), got " << pressure;
+    throw std::invalid_argument(out.str());
   }
   const double J = eos_.volume_ratio(pressure);
   const auto count = static_cast<std::size_t>(std::max(1.0, std::ceil(front / particle_length_ - 1e-9)));

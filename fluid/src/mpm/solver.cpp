@@ -199,6 +199,7 @@ void FluidSolver::step(double dt) {
   t_ += dt;
   ++steps_;
   update_state();
+  check_compression();
   project_pressure();
   inlet_flux_ = (injected_mass_ - injected_before) / (config_.density * dt);
 }
@@ -282,6 +283,21 @@ void FluidSolver::p2g() {
   // Boundary pressures: the inlet at the mouth pushes in; a wetted outlet pushes back.
   force_[0] += mouth_pressure() * grid_.width()[0];
   if (outlet_wetted_) force_[n - 1] -= std::max(0.0, config_.outlet.pressure(t_)) * grid_.width()[n - 1];
+}
+
+void FluidSolver::check_compression() const {
+  const double K = config_.bulk_modulus;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    if (!(particles_.pressure[p] <= K)) {
+      std::ostringstream out;
+      out << "fluid: crack " << grid_.crack_id() << ": at t = " << t_ << " s the fluid at s = " << particles_.s[p]
+          << " m is compressed to p = " << particles_.pressure[p] << " Pa, above its bulk modulus " << K
+          << " Pa (volume ratio below " << eos_.volume_ratio(K)
+          << "): no liquid's equation of state holds there, and the step that did it has failed (a step too "
+             "large for the coupling, or fluid trapped in a crack that closes)";
+      throw std::runtime_error(out.str());
+    }
+  }
 }
 
 void FluidSolver::grid_update(double dt) {

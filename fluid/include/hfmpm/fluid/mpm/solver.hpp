@@ -180,6 +180,10 @@ class FluidSolver {
   void split_inlet();
   void merge(std::size_t p);  // merge particle p + 1 into p
   void merge_short();         // see FluidConfig::merge_fraction
+  // Throws when a particle's pressure exceeds the bulk modulus: a liquid
+  // compressed that far (J < 1 - c ln(1 + 1/c), 0.78 for water) is outside
+  // any equation of state, and the step that did it has failed.
+  void check_compression() const;
   // output.cpp
   void project_pressure();
   // Nodal pressures from particle pressures `pp` (the mass-weighted CPDI
