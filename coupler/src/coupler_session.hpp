@@ -24,12 +24,12 @@
 #include <sstream>
 #include <thread>
 
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/coupling/process.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
-#include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/runtime/curve.hpp"
+#include "hfmpm/runtime/transport.hpp"
 #include "run_output.hpp"
 
 namespace hfmpm::coupling::detail {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {

@@ -12,8 +12,8 @@
 #include <thread>
 #include <zmq.hpp>
 
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/curve.hpp"
 
 namespace hfmpm::coupling {
 

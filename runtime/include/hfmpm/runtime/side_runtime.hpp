@@ -12,9 +12,9 @@
 #include <vector>
 #include <zmq.hpp>
 
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/exchange.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/curve.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {

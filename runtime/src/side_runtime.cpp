@@ -1,4 +1,4 @@
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 
 #include <malloc.h>
 #include <unistd.h>
@@ -17,8 +17,8 @@
 
 #include "exchange_log.hpp"
 #include "heartbeat.hpp"
-#include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/runtime/transport.hpp"
 #include "side_checks.hpp"
 
 namespace hfmpm::coupling {

@@ -1,4 +1,4 @@
-#include "hfmpm/coupling/transport.hpp"
+#include "hfmpm/runtime/transport.hpp"
 
 #include <algorithm>
 #include <vector>

@@ -6,8 +6,8 @@
 #include <string>
 #include <zmq.hpp>
 
-#include "hfmpm/coupling/side_runtime.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 
 namespace hfmpm::coupling {
 

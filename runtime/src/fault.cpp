@@ -6,7 +6,7 @@
 #include <string>
 #include <thread>
 
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 #include "side_checks.hpp"
 
 namespace hfmpm::coupling {
