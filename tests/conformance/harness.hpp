@@ -17,7 +17,7 @@
 
 #include "hfmpm/coupling/process.hpp"
 #include "hfmpm/protocol.pb.h"
-#include "hfmpm/runtime/transport.hpp"
+#include "hfmpm/runtime/zmq_transport.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::conformance {

@@ -1,15 +1,21 @@
-// Thin helpers over cppzmq: every message is one frame holding one Envelope
-// (the coupler's ROUTER adds the peer's routing id in front). No physics here.
+// How a side and the coupler talk: links that carry one Envelope per message.
+// The side runtime and the coupler see only these interfaces; ZeroMQ
+// (zmq_transport.hpp: processes, ipc/tcp, or inproc threads) and plain queues
+// in memory (memory_transport.hpp: the coupler and both sides as threads of
+// one process, no sockets) implement them. No physics here.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
-#include <zmq.hpp>
 
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/curve.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {
@@ -18,53 +24,98 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start);
 
-// Sockets never block process exit for more than this (ms) on unsent messages.
-inline constexpr int kLingerMs = 500;
-
-// Largest message a socket accepts (ZMQ_MAXMSGSIZE; a peer that sends more
-// is disconnected before the bytes are kept). The coupler hears only small
-// control messages; a side's control socket receives Welcome with the scene
-// (scene files are at most 16 MiB of text); the data plane carries the crack
-// and fluid state, bounded from the scene (data_plane_message_limit).
-inline constexpr std::int64_t kCouplerMaxMessageBytes = std::int64_t{4} << 20;
-inline constexpr std::int64_t kSideControlMaxMessageBytes = std::int64_t{64} << 20;
 // Data-plane limit for a scene: 16 MiB plus 2 KiB for every crack particle
 // the grid can hold along its cracks (8 per cell over the grid's width plus
 // height, per crack), or 256 MiB without an MPM grid.
 std::int64_t data_plane_message_limit(const scene::Scene& scene);
 
-// How long a connection may take to complete the ZeroMQ handshake (and, on
-// tcp, CURVE) before it is dropped: a peer that connects and says nothing
-// holds a descriptor for at most this long.
-inline constexpr int kHandshakeMs = 5000;
+// One end of a link: a side's control link to the coupler, its heartbeat
+// link, or one end of the data plane between the sides. Every message is one
+// frame holding one encoded Envelope. Used from one thread at a time.
+class Link {
+ public:
+  virtual ~Link() = default;
+  // One message of raw bytes. wait: block until it is queued; otherwise
+  // return false at once if it cannot be (a data link whose peer has not
+  // connected yet).
+  virtual bool send_bytes(const std::string& bytes, bool wait) = 0;
+  // Waits up to `timeout` for one message (busy-polling for `spin` first).
+  // Throws proto::ProtocolError naming `from` if the bytes are not exactly
+  // one valid Envelope.
+  virtual std::optional<protocol::Envelope> receive(std::string_view from, std::chrono::microseconds timeout,
+                                                    std::chrono::microseconds spin = std::chrono::microseconds(0)) = 0;
+  // A bound link: the endpoint it is reachable at (the port chosen); "" otherwise.
+  virtual std::string endpoint() const = 0;
 
-void send(zmq::socket_t& socket, const protocol::Envelope& envelope);
+  // One Envelope, waiting until it is queued; throws std::runtime_error if it cannot be sent.
+  void send(const protocol::Envelope& envelope);
+};
 
-// Waits up to `timeout` for one message. `spin` is a busy-poll phase before
-// sleeping (trades one core for latency). Throws ProtocolError if the bytes
-// are not a valid Envelope.
-std::optional<protocol::Envelope> receive(zmq::socket_t& socket, std::string_view from,
-                                          std::chrono::microseconds timeout,
-                                          std::chrono::microseconds spin = std::chrono::microseconds(0));
-
-// One message on a ROUTER: who sent it and the raw payload.
+// One message at the coupler's end: who sent it and the raw payload.
 struct Routed {
   std::string peer;
   std::string payload;
   bool well_framed = true;  // exactly [routing id][payload]
 };
-std::optional<Routed> receive_routed(zmq::socket_t& router, std::chrono::microseconds timeout);
-void send_routed(zmq::socket_t& router, const std::string& peer, const protocol::Envelope& envelope);
+
+// The coupler's end of the control plane: every side connects its control
+// link (routing id "solid", "fluid") and heartbeat link ("solid.hb", ...).
+class Router {
+ public:
+  virtual ~Router() = default;
+  virtual std::optional<Routed> receive(std::chrono::microseconds timeout) = 0;
+  // Throws std::runtime_error if `peer` is not connected.
+  virtual void send(const std::string& peer, const protocol::Envelope& envelope) = 0;
+  virtual std::string endpoint() const = 0;  // the bound endpoint (the port chosen)
+};
+
+// Who may join the coupler on tcp: CURVE with the coupler's secret key, and
+// only peers presenting the sides' public key (docs/reliability.md).
+struct RouterSecurity {
+  std::optional<CurveKeys> curve;
+  std::function<void(const std::string&)> refused;  // told about refused peers (another thread)
+};
+
+// A wait on several links at once (like zmq_poll).
+struct PollItem {
+  Link* link = nullptr;
+  bool for_send = false;  // wait until a message can be queued, not until one arrives
+  bool ready = false;     // set by Transport::poll
+};
+
+// Makes the links of one process (ZeroMQ: one context) or, in memory, of
+// the coupler and side threads of one run. Thread-safe.
+class Transport {
+ public:
+  virtual ~Transport() = default;
+  // The coupler: binds its control endpoint; throws std::runtime_error (the
+  // transport's words) if it cannot.
+  virtual std::unique_ptr<Router> bind_router(const std::string& endpoint, const RouterSecurity& security) = 0;
+  // A side: its control link to the coupler, routing id = the role's name.
+  virtual std::unique_ptr<Link> connect_control(const std::string& endpoint, protocol::Role role,
+                                                const std::optional<CurveKeys>& curve) = 0;
+  // A side: its heartbeat link, routing id "<role>.hb" (sends never wait).
+  virtual std::unique_ptr<Link> connect_heartbeat(const std::string& endpoint, protocol::Role role,
+                                                  const std::optional<CurveKeys>& curve) = 0;
+  // The data plane: the solid binds, the fluid connects. `curve` (tcp only):
+  // a CURVE server admitting only the sides' key / a client holding it.
+  virtual std::unique_ptr<Link> bind_data(const std::string& endpoint, std::int64_t max_message_bytes,
+                                          const std::optional<CurveKeys>& curve) = 0;
+  virtual std::unique_ptr<Link> connect_data(const std::string& endpoint, std::int64_t max_message_bytes,
+                                             const std::optional<CurveKeys>& curve) = 0;
+  // Waits up to `timeout` until an item is ready; marks them; returns how many are.
+  virtual int poll(std::span<PollItem> items, std::chrono::milliseconds timeout) = 0;
+};
+
+// `text` fit for a log line: at most `max` characters, anything outside
+// printable ASCII as \xNN (a peer's name cannot forge lines or reach the
+// terminal as escape sequences).
+std::string printable(const std::string& text, std::size_t max = 64);
 
 // "tcp://0.0.0.0:5555" with host "node7" -> "tcp://node7:5555"; other transports unchanged.
 std::string advertise(const std::string& bound_endpoint, const std::string& host);
 
 // The host part of a tcp endpoint, "" otherwise.
 std::string tcp_host(const std::string& endpoint);
-
-// `text` fit for a log line: at most `max` characters, anything outside
-// printable ASCII as \xNN (a peer's name cannot forge lines or reach the
-// terminal as escape sequences).
-std::string printable(const std::string& text, std::size_t max = 64);
 
 }  // namespace hfmpm::coupling
