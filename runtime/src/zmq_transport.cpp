@@ -4,6 +4,7 @@
 #include "hfmpm/runtime/zmq_transport.hpp"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <vector>
 
@@ -183,13 +184,15 @@ class ZmqTransport final : public Transport {
   }
 
   int poll(std::span<PollItem> items, std::chrono::milliseconds timeout) override {
-    std::vector<zmq::pollitem_t> polled;
-    polled.reserve(items.size());
-    for (auto& item : items) {
-      auto& socket = dynamic_cast<ZmqLink&>(*item.link).socket();
-      polled.push_back({socket.handle(), 0, static_cast<short>(item.for_send ? ZMQ_POLLOUT : ZMQ_POLLIN), 0});
+    // No allocation: consume() polls in a busy loop while it spins (coupling.spin_us).
+    constexpr std::size_t kMaxItems = 4;
+    if (items.size() > kMaxItems) throw std::invalid_argument("poll: at most 4 links at once");
+    std::array<zmq::pollitem_t, kMaxItems> polled{};
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      auto& socket = dynamic_cast<ZmqLink&>(*items[i].link).socket();
+      polled[i] = {socket.handle(), 0, static_cast<short>(items[i].for_send ? ZMQ_POLLOUT : ZMQ_POLLIN), 0};
     }
-    const int ready = zmq::poll(polled.data(), polled.size(), timeout);
+    const int ready = zmq::poll(polled.data(), items.size(), timeout);
     for (std::size_t i = 0; i < items.size(); ++i) items[i].ready = (polled[i].revents & polled[i].events) != 0;
     return ready;
   }
