@@ -19,7 +19,7 @@
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/process.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
-#include "hfmpm/coupling/transport.hpp"
+#include "hfmpm/runtime/transport.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
 

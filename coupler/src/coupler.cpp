@@ -23,7 +23,7 @@ namespace detail {
 Coupler::Coupler(const scene::Scene& scene, const RunOptions& options)
     : scene_(scene),
       options_(options),
-      router_(*context_, zmq::socket_type::router),
+      transport_(options.transport ? options.transport : make_zmq_transport()),
       progress_(options.progress, scene.time().end_s()) {
   sides_[0].role = protocol::SOLID;
   sides_[0].name = "solid";
@@ -40,9 +40,6 @@ Coupler::~Coupler() {
   for (auto& side : sides_) {
     if (side.thread.joinable()) side.thread.join();
   }
-  // Terminating a context waits for every socket to close; a detached side
-  // thread may never close its own, so its context is left to process exit.
-  if (leak_context_) (void)context_.release();
   if (!ipc_dir_.empty()) {
     std::error_code ignored;
     fs::remove_all(ipc_dir_, ignored);
@@ -96,7 +93,7 @@ RunSummary Coupler::run() {
   summary.fluid_compute_s = sides_[1].compute_s;
   summary.solid_exchange_s = sides_[0].exchange_s;
   summary.fluid_exchange_s = sides_[1].exchange_s;
-  summary.sides_in_sequence = scene_.coupling().scheme() != scene::Coupling::JACOBI;
+  summary.sides_in_sequence = CouplingScheme::of(scene_).sides_in_sequence();
   manifest_.set_number("steps", static_cast<double>(step_));
   manifest_.set_number("end_time_s", t_);
   manifest_.set_number("wall_s", summary.wall_s);
@@ -174,11 +171,12 @@ void Coupler::prepare() {
     }
   }
 
-  router_.set(zmq::sockopt::linger, kLingerMs);
-  router_.set(zmq::sockopt::router_mandatory, 1);
-  router_.set(zmq::sockopt::maxmsgsize, kCouplerMaxMessageBytes);
-  router_.set(zmq::sockopt::handshake_ivl, kHandshakeMs);
   const auto transport = scene_.coupling().transport();
+  if (options_.transport && (transport != scene::Coupling::INPROC || !options_.launch)) {
+    throw RunFailure{
+        "a transport given to the coupler serves only sides it starts as threads (coupling.transport: "
+        "INPROC)"};
+  }
   std::string bind = options_.bind_endpoint;
   if (bind.empty()) {
     if (transport == scene::Coupling::INPROC) {
@@ -195,6 +193,7 @@ void Coupler::prepare() {
     }
   }
   std::string side_keys;  // the key file the launched sides get
+  RouterSecurity security;
   if (bind.rfind("tcp://", 0) == 0) {
     if (options_.insecure_tcp) {
       manifest_.set("tcp_security", "none (--insecure-tcp): anyone who reaches the port can join");
@@ -217,21 +216,24 @@ void Coupler::prepare() {
         side_keys = keys_dir_ + "/side.keys";
         write_side_key_file(side_keys, keys);
       }
-      zap_ = std::make_unique<ZapAuthenticator>(*context_, keys.client_public, [this](const std::string& line) {
+      security.curve = keys;
+      security.refused = [this](const std::string& line) {
         std::lock_guard<std::mutex> lock(refusals_mutex_);
         refusals_ += (refusals_.empty() ? "" : "\n") + line;
-      });
-      make_curve_server(router_, keys.server_secret);
+      };
+      curve_ = true;
       manifest_.set("tcp_security", "CURVE");
     }
   }
   side_keys_ = side_keys;
   try {
-    router_.bind(bind);
+    router_ = transport_->bind_router(bind, security);
   } catch (const zmq::error_t& e) {
     throw RunFailure{"cannot bind the control endpoint " + bind + ": " + e.what()};
+  } catch (const std::runtime_error& e) {
+    throw RunFailure{"cannot bind the control endpoint " + bind + ": " + e.what()};
   }
-  control_endpoint_ = router_.get(zmq::sockopt::last_endpoint);
+  control_endpoint_ = router_->endpoint();
   if (data_bind_.empty()) {
     const std::string host = tcp_host(control_endpoint_);
     if (!host.empty()) {
@@ -303,7 +305,7 @@ void Coupler::launch_sides() {
       side_options.role = side.role;
       side_options.control_endpoint = control_endpoint_;
       side_options.implementation = std::string("in-process ") + side.name;
-      side_options.context = context_.get();
+      side_options.transport = transport_;
       side.thread =
           std::thread([model, side_options, exit = side.thread_exit] { *exit = run_side(*model, side_options); });
       manifest_.set(side.name + "_program", "in-process thread");
@@ -335,9 +337,9 @@ void Coupler::stop_sides(bool error, const std::string& reason) {
   for (auto& side : sides_) {
     if (!side.expected || side.stopping) continue;
     side.stopping = true;
-    if (side.joined || side.thread_exit) {  // an in-process side may be connected before its Hello is read
+    if (router_ && (side.joined || side.thread_exit)) {  // an in-process side may be connected before its Hello is read
       try {
-        send_routed(router_, side.name, envelope);
+        router_->send(side.name, envelope);
       } catch (const std::exception&) {
       }
     }
@@ -361,8 +363,7 @@ void Coupler::stop_sides(bool error, const std::string& reason) {
         side.thread.join();
       } else {
         log_("the in-process " + side.name + " side did not stop; leaving it to end with the process");
-        side.thread.detach();
-        leak_context_ = true;
+        side.thread.detach();  // it holds the transport (transport_)
       }
     }
   }

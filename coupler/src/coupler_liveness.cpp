@@ -17,7 +17,7 @@ std::string Coupler::log_hint(const Side& side) const {
 
 std::optional<std::pair<Side*, protocol::Envelope>> Coupler::pump(microseconds wait) {
   housekeeping();
-  auto routed = receive_routed(router_, wait);
+  auto routed = router_->receive(wait);
   if (!routed) return std::nullopt;
   const auto dot = routed->peer.find('.');
   const std::string base = routed->peer.substr(0, dot);
@@ -89,7 +89,7 @@ void Coupler::housekeeping() {
   }
   last_housekeeping_ = now;
   if (!stepping_) check_stop_request();  // while the sides join; in the loop, between rounds
-  if (zap_) {
+  if (curve_) {
     std::string refusals;
     {
       std::lock_guard<std::mutex> lock(refusals_mutex_);
@@ -139,7 +139,7 @@ std::string Coupler::ended_message(Side& side, const std::string& ended) {
 std::string Coupler::drain_error_from(Side& side) {
   const auto until = Clock::now() + milliseconds(200);
   while (Clock::now() < until) {
-    auto routed = receive_routed(router_, milliseconds(20));
+    auto routed = router_->receive(milliseconds(20));
     if (!routed || routed->peer != side.name) continue;
     try {
       const auto envelope = proto::decode(routed->payload.data(), routed->payload.size(), side.name);
@@ -152,7 +152,7 @@ std::string Coupler::drain_error_from(Side& side) {
 
 void Coupler::send_to(Side& side, const protocol::Envelope& envelope) {
   try {
-    send_routed(router_, side.name, envelope);
+    router_->send(side.name, envelope);
     side.last_sent = Clock::now();
   } catch (const std::exception& e) {
     // Usually the process has just died: say how, rather than that a send failed.

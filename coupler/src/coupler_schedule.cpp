@@ -118,7 +118,7 @@ void Coupler::reject(Side& side, const std::string& reason) {
   envelope.mutable_reject()->set_coupler_protocol_version(proto::kProtocolVersion);
   envelope.mutable_reject()->set_coupler_scene_schema_version(proto::kSceneSchemaVersion);
   try {
-    send_routed(router_, side.name, envelope);
+    router_->send(side.name, envelope);
   } catch (const std::exception&) {
   }
   throw RunFailure{"rejected " + reason + " (handshake, step 0)"};
@@ -178,7 +178,7 @@ void Coupler::step_loop(RunSummary& summary) {
   const auto start = Clock::now();
   const double end = scene_.time().end_s();
   const double interval = output_interval(scene_);
-  const std::uint32_t k = sides_[1].expected ? scene_.coupling().exchange_interval() : 1;
+  const std::uint32_t k = CouplingScheme::of(scene_).exchange_interval();  // 1 in a dry run
   const std::uint64_t block = (std::uint64_t{scene_.coupling().control_interval()} + k - 1) / k * k;
   double dt = next_dt();
   if (const auto warning = check_step_count(scene_, t_, dt, end, dt_limit_, at_step()); !warning.empty()) log_(warning);

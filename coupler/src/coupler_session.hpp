@@ -24,12 +24,14 @@
 #include <sstream>
 #include <thread>
 
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/coupling/process.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
-#include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/runtime/coupling_scheme.hpp"
+#include "hfmpm/runtime/curve.hpp"
+#include "hfmpm/runtime/transport.hpp"
+#include "hfmpm/runtime/zmq_transport.hpp"
 #include "run_output.hpp"
 
 namespace hfmpm::coupling::detail {
@@ -155,21 +157,23 @@ class Coupler {
 
   scene::Scene scene_;
   RunOptions options_;
-  std::unique_ptr<zmq::context_t> context_ = std::make_unique<zmq::context_t>(1);
-  std::unique_ptr<ZapAuthenticator> zap_;  // tcp with CURVE; before router_: outlives it
+  // Shared with in-process side threads; before router_: outlives it. A side
+  // thread left behind (stop_sides) keeps it alive: ZeroMQ's context then
+  // ends with the process instead of waiting here for its sockets.
+  std::shared_ptr<Transport> transport_;
+  bool curve_ = false;  // tcp with CURVE: refusals are logged
   std::mutex refusals_mutex_;
   std::string refusals_;         // told by the ZAP thread, logged by housekeeping()
   std::string keys_dir_;         // the sides' key file of a launched tcp run (0700, removed at the end)
   std::string side_keys_;        // that file, passed to the sides with --keys
   std::uint64_t strangers_ = 0;  // messages from peers that are not a side (plain tcp)
   Clock::time_point last_stranger_log_{};
-  zmq::socket_t router_;
+  std::unique_ptr<Router> router_;  // bound in prepare()
   Side sides_[2];
   std::string run_id_, output_dir_, control_endpoint_, data_bind_, ipc_dir_;
   Manifest manifest_{""};
   std::unique_ptr<History> history_;
   bool prepared_ = false;
-  bool leak_context_ = false;
   bool stopped_at_max_steps_ = false;
   bool stepping_ = false;  // in the step loop: stop requests are taken between control rounds
   // Largest fluid pressure change at frozen crack width over a report, and when (run.json).

@@ -4,8 +4,8 @@
 
 #include <memory>
 
-#include "hfmpm/coupling/side_runtime.hpp"
 #include "hfmpm/fluid/mpm/config.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 
 namespace hfmpm::fluid {
 

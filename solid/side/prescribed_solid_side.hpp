@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 
 namespace hfmpm::solid {
 

@@ -16,8 +16,8 @@
 #include <zmq.hpp>
 
 #include "hfmpm/coupling/process.hpp"
-#include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/protocol.pb.h"
+#include "hfmpm/runtime/zmq_transport.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::conformance {

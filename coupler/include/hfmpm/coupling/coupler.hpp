@@ -11,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
+#include "hfmpm/runtime/transport.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {
@@ -29,8 +30,12 @@ struct RunOptions {
   std::string solid_program;   // override the solid program (another implementation)
   std::string fluid_program;
   ModelFactory inproc_factory;  // required for INPROC
-  bool progress = true;         // progress line on stderr
-  std::string scene_path;       // for the manifest
+  // What the coupler and in-process sides talk through: null for ZeroMQ (a
+  // context of the run's own), or another Transport shared with the side
+  // threads, e.g. a MemoryTransport (only with coupling.transport INPROC).
+  std::shared_ptr<Transport> transport;
+  bool progress = true;    // progress line on stderr
+  std::string scene_path;  // for the manifest
   std::vector<std::string> overrides;
   std::function<void(const std::string&)> on_bound;  // told the bound control endpoint
   // A stop request (install_stop_signals): 0, or the signal that asked the

@@ -4,10 +4,10 @@
 
 #include <cstdint>
 #include <string>
-#include <zmq.hpp>
 
-#include "hfmpm/coupling/side_runtime.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
+#include "hfmpm/runtime/transport.hpp"
 
 namespace hfmpm::coupling {
 
@@ -21,9 +21,8 @@ void check_step_command(const protocol::StepCommand& command, std::uint64_t step
 void check_data_frame(const protocol::Envelope& envelope, protocol::Role role, std::uint64_t expected);
 
 // The --fault hook at `step`: exits, aborts, hangs, stops itself or sends
-// garbage on the given sockets; returns true for Kind::NaN (poison the next
+// garbage on the given links; returns true for Kind::NaN (poison the next
 // frame). Does nothing unless `fault` is due at `step`.
-bool act_on_fault(const Fault& fault, std::uint64_t step, const std::string& role, zmq::socket_t& control,
-                  zmq::socket_t* data);
+bool act_on_fault(const Fault& fault, std::uint64_t step, const std::string& role, Link& control, Link* data);
 
 }  // namespace hfmpm::coupling

@@ -9,9 +9,9 @@
 #include <map>
 
 #include "hfmpm/coupling/coupler.hpp"
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
+#include "hfmpm/runtime/curve.hpp"
 #include "mpm_fluid_side.hpp"
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"

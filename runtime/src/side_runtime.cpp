@@ -1,4 +1,4 @@
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 
 #include <malloc.h>
 #include <unistd.h>
@@ -17,8 +17,9 @@
 
 #include "exchange_log.hpp"
 #include "heartbeat.hpp"
-#include "hfmpm/coupling/transport.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/runtime/coupling_scheme.hpp"
+#include "hfmpm/runtime/zmq_transport.hpp"
 #include "side_checks.hpp"
 
 namespace hfmpm::coupling {
@@ -47,20 +48,10 @@ class SideRuntime {
   SideRuntime(SideModel& model, const SideOptions& options)
       : model_(model),
         options_(options),
-        own_context_(options.context ? nullptr : std::make_unique<zmq::context_t>(1)),
-        context_(options.context ? *options.context : *own_context_),
-        control_(context_, zmq::socket_type::dealer),
+        transport_(options.transport ? options.transport : make_zmq_transport()),
+        control_(transport_->connect_control(options.control_endpoint, options.role, options.curve)),
         role_(std::string(proto::role_name(options.role))),
-        peer_(options.role == protocol::SOLID ? "fluid" : "solid") {
-    control_.set(zmq::sockopt::linger, kLingerMs);
-    control_.set(zmq::sockopt::routing_id, role_);
-    control_.set(zmq::sockopt::maxmsgsize, kSideControlMaxMessageBytes);
-    if (options.curve) {
-      make_curve_client(control_, options.curve->server_public, options.curve->client_public,
-                        options.curve->client_secret);
-    }
-    control_.connect(options.control_endpoint);
-  }
+        peer_(options.role == protocol::SOLID ? "fluid" : "solid") {}
 
   int run() {
     try {
@@ -100,7 +91,7 @@ class SideRuntime {
       error->set_where("step " + std::to_string(step_));
       error->set_message(message);
       error->set_step(step_);
-      send(control_, envelope);
+      control_->send(envelope);
     } catch (...) {
       // The coupler may already be gone; the exit code still tells.
     }
@@ -119,10 +110,10 @@ class SideRuntime {
     for (const auto& c : options_.capabilities) hello->add_capabilities(c);
     hello->set_host(host_name());
     hello->set_pid(getpid());
-    send(control_, hello_envelope);
+    control_->send(hello_envelope);
     // From now on the coupler hears from this side even during a long setup.
-    heartbeat_ = std::make_unique<HeartbeatThread>(context_, options_.control_endpoint, options_.role, heartbeat_step_,
-                                                   waiting_for_peer_, options_.curve);
+    heartbeat_ = std::make_unique<HeartbeatThread>(*transport_, options_.control_endpoint, options_.role,
+                                                   heartbeat_step_, waiting_for_peer_, options_.curve);
 
     const auto deadline = Clock::now() + to_us(options_.welcome_timeout_s);
     while (true) {
@@ -131,7 +122,7 @@ class SideRuntime {
         throw CouplerLost{"no answer to Hello from the coupler at " + options_.control_endpoint + " within " +
                           std::to_string(options_.welcome_timeout_s) + " s"};
       }
-      auto envelope = receive(control_, "the coupler", left);
+      auto envelope = control_->receive("the coupler", left);
       if (!envelope || envelope->has_heartbeat()) continue;
       if (envelope->has_reject()) {
         std::cerr << role_ << ": the coupler rejected this side: " << envelope->reject().reason() << "\n";
@@ -163,14 +154,6 @@ class SideRuntime {
     const auto& scene = welcome_.scene();
     heartbeat_timeout_ = to_us(scene.coupling().heartbeat_timeout_s());
     spin_ = microseconds(scene.coupling().spin_us());
-    exchange_interval_ = std::max(1u, scene.coupling().exchange_interval());
-    // Sequential schemes: one side waits for the other's frame of the same
-    // step before it steps. Gauss-Seidel: the fluid waits for the solid's new
-    // crack. Implicit: the solid waits for the pressure the fluid solved
-    // over the step it is about to finish.
-    const auto scheme = scene.coupling().scheme();
-    waits_first_ = (scheme == scene::Coupling::GAUSS_SEIDEL && options_.role == protocol::FLUID) ||
-                   (scheme == scene::Coupling::IMPLICIT && options_.role == protocol::SOLID);
 
     const std::string& chosen = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
     const std::string output_dir = chosen.empty() ? std::string(".") : chosen;
@@ -191,51 +174,43 @@ class SideRuntime {
     if (mode == protocol::DataPlane::BIND && options_.role != protocol::SOLID) {
       throw proto::ProtocolError("Welcome asks a " + role_ + " side to bind the data plane; only the solid binds");
     }
-    has_peer_ = mode == protocol::DataPlane::BIND || mode == protocol::DataPlane::CONNECT;
-    if (has_peer_) {
-      data_.emplace(context_, zmq::socket_type::pair);
-      data_->set(zmq::sockopt::linger, kLingerMs);
-      data_->set(zmq::sockopt::maxmsgsize, data_plane_message_limit(welcome_.scene()));
-      data_->set(zmq::sockopt::handshake_ivl, kHandshakeMs);
-      const bool curve = options_.curve && welcome_.data_plane().endpoint().rfind("tcp://", 0) == 0;
-      if (curve && mode == protocol::DataPlane::BIND) {
-        // Only the other side, holding the same key pair, gets through.
-        zap_ = std::make_unique<ZapAuthenticator>(context_, options_.curve->client_public);
-        make_curve_server(*data_, options_.curve->client_secret);
-      } else if (curve) {
-        make_curve_client(*data_, options_.curve->client_public, options_.curve->client_public,
-                          options_.curve->client_secret);
-      }
+    const bool has_peer = mode == protocol::DataPlane::BIND || mode == protocol::DataPlane::CONNECT;
+    scheme_.emplace(scene.coupling().scheme(), scene.coupling().exchange_interval(), has_peer);
+    if (has_peer) {
+      // CURVE on tcp only: a bound data link admits only the other side, holding the same key pair.
+      const bool tcp = welcome_.data_plane().endpoint().rfind("tcp://", 0) == 0;
+      std::optional<CurveKeys> curve;
+      if (tcp) curve = options_.curve;
+      const auto limit = data_plane_message_limit(welcome_.scene());
       if (mode == protocol::DataPlane::BIND) {
-        data_->bind(welcome_.data_plane().endpoint());
+        data_ = transport_->bind_data(welcome_.data_plane().endpoint(), limit, curve);
         std::string host = options_.advertise_host;
         if (host.empty()) {
           host = tcp_host(options_.control_endpoint);
           if (host.empty() || host == "*" || host == "0.0.0.0") host = host_name();
         }
-        std::string bound = data_->get(zmq::sockopt::last_endpoint);
+        std::string bound = data_->endpoint();
         if (tcp_host(bound) == "0.0.0.0") bound = advertise(bound, host);
         protocol::Envelope listening;
         listening.mutable_listening()->set_data_endpoint(bound);
-        send(control_, listening);
+        control_->send(listening);
       } else {
-        data_->connect(welcome_.data_plane().endpoint());
+        data_ = transport_->connect_data(welcome_.data_plane().endpoint(), limit, curve);
       }
-      // Initial exchange (step 0): the solid goes first, the fluid builds its
-      // grid from the crack before it can answer.
-      if (options_.role == protocol::SOLID) {
-        publish();
-        consume(0);
-      } else {
-        consume(0);
-        publish();
+      // Initial exchange (step 0), in the scheme's order.
+      for (const auto& action : scheme_->initial_exchange(options_.role)) {
+        if (action.kind == CouplingScheme::Action::Publish) {
+          publish();
+        } else {
+          consume(action.step);
+        }
       }
     }
     protocol::Envelope ready;
     ready.mutable_ready()->set_stable_dt(model_.stable_dt());
     ready.mutable_ready()->set_stable_dt_limit(model_.stable_dt_limit());
     proto::to_proto(model_.diagnostics(), ready.mutable_ready()->mutable_diagnostics());
-    send(control_, ready);
+    control_->send(ready);
   }
 
   // ------------------------------------------------------------ step loop
@@ -264,7 +239,7 @@ class SideRuntime {
   protocol::Envelope next_command() {
     while (true) {
       const auto wait_start = Clock::now();
-      auto envelope = receive(control_, "the coupler", heartbeat_timeout_);
+      auto envelope = control_->receive("the coupler", heartbeat_timeout_);
       if (!envelope) {
         if (coupler_silent(wait_start, heartbeat_timeout_)) {
           throw CouplerLost{"nothing from the coupler for " +
@@ -280,7 +255,7 @@ class SideRuntime {
   }
 
   void check_command(const protocol::StepCommand& command) const {
-    check_step_command(command, step_, t_, has_peer_ ? exchange_interval_ : 1);
+    check_step_command(command, step_, t_, scheme_->exchange_interval());
   }
 
   void execute(const protocol::StepCommand& command) {
@@ -288,24 +263,26 @@ class SideRuntime {
     t_ = command.t();
     double compute_s = 0, exchange_s = 0;
     publish_compute_s_ = 0;
-    for (std::uint32_t i = 0; i < command.num_steps(); ++i) {
-      if (has_peer_ && waits_first_ && step_ % exchange_interval_ == 0) {
-        const auto start = Clock::now();
-        consume(step_ + exchange_interval_);
-        exchange_s += seconds_since(start);
-      }
-      inject_fault(step_ + 1);
+    // The steps, sends and waits of this block in the scheme's order.
+    for (const auto& action : scheme_->block(options_.role, step_, command.num_steps())) {
       const auto start = Clock::now();
-      model_.advance(command.dt());
-      ++step_;
-      heartbeat_step_ = step_;
-      t_ += command.dt();
-      compute_s += seconds_since(start);
-      if (has_peer_ && step_ % exchange_interval_ == 0) {
-        const auto exchange_start = Clock::now();
-        publish();
-        if (!waits_first_) consume(step_);
-        exchange_s += seconds_since(exchange_start);
+      switch (action.kind) {
+        case CouplingScheme::Action::Advance:
+          inject_fault(step_ + 1);
+          model_.advance(command.dt());
+          ++step_;
+          heartbeat_step_ = step_;
+          t_ += command.dt();
+          compute_s += seconds_since(start);
+          break;
+        case CouplingScheme::Action::Publish:
+          publish();
+          exchange_s += seconds_since(start);
+          break;
+        case CouplingScheme::Action::Consume:
+          consume(action.step);
+          exchange_s += seconds_since(start);
+          break;
       }
     }
     // What the model did inside publish() is compute, not exchange.
@@ -324,7 +301,7 @@ class SideRuntime {
     proto::to_proto(model_.diagnostics(), report->mutable_diagnostics());
     report->set_compute_s(compute_s);
     report->set_exchange_s(exchange_s);
-    send(control_, envelope);
+    control_->send(envelope);
   }
 
   // ----------------------------------------------------------- data plane
@@ -347,16 +324,16 @@ class SideRuntime {
     send_data(envelope);
   }
 
-  // A PAIR socket blocks a send until its peer is connected: wait for that
-  // while watching the coupler, as consume() does.
+  // A data link may not take a message until its peer is connected (a
+  // ZeroMQ PAIR): wait for that while watching the coupler, as consume() does.
   void send_data(const protocol::Envelope& envelope) {
     const std::string bytes = proto::encode(envelope);
-    while (!data_->send(zmq::buffer(bytes), zmq::send_flags::dontwait)) {
-      zmq::pollitem_t items[] = {{data_->handle(), 0, ZMQ_POLLOUT, 0}, {control_.handle(), 0, ZMQ_POLLIN, 0}};
+    while (!data_->send_bytes(bytes, false)) {
+      PollItem items[] = {{data_.get(), true}, {control_.get(), false}};
       const auto wait_start = Clock::now();
-      zmq::poll(items, 2, std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_));
-      if (items[1].revents & ZMQ_POLLIN) watch_coupler("to send data to the " + peer_ + " side");
-      if (!(items[0].revents & ZMQ_POLLOUT) && coupler_silent(wait_start, heartbeat_timeout_)) {
+      transport_->poll(items, std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_));
+      if (items[1].ready) watch_coupler("to send data to the " + peer_ + " side");
+      if (!items[0].ready && coupler_silent(wait_start, heartbeat_timeout_)) {
         throw CouplerLost{"nothing from the coupler for " +
                           std::to_string(welcome_.scene().coupling().heartbeat_timeout_s()) +
                           " s while waiting to send data to the " + peer_ + " side"};
@@ -366,7 +343,7 @@ class SideRuntime {
 
   // One message from the coupler while busy on the data plane: a heartbeat or Shutdown.
   void watch_coupler(const std::string& doing) {
-    auto envelope = receive(control_, "the coupler", microseconds(0));
+    auto envelope = control_->receive("the coupler", microseconds(0));
     if (!envelope) return;
     last_from_coupler_ = Clock::now();
     if (envelope->has_shutdown()) throw ShutdownRequested{envelope->shutdown().error()};
@@ -380,23 +357,23 @@ class SideRuntime {
       explicit Waiting(std::atomic<bool>& f) : flag(f) { flag = true; }
       ~Waiting() { flag = false; }
     } waiting(waiting_for_peer_);
-    zmq::pollitem_t items[] = {{data_->handle(), 0, ZMQ_POLLIN, 0}, {control_.handle(), 0, ZMQ_POLLIN, 0}};
+    PollItem items[] = {{data_.get(), false}, {control_.get(), false}};
     const auto spin_end = Clock::now() + spin_;
     while (true) {
       const bool spinning = Clock::now() < spin_end;
       const auto timeout = spinning ? std::chrono::milliseconds(0)
                                     : std::chrono::duration_cast<std::chrono::milliseconds>(heartbeat_timeout_);
       const auto wait_start = Clock::now();
-      zmq::poll(items, 2, timeout);
-      if (items[0].revents & ZMQ_POLLIN) {
-        auto envelope = receive(*data_, "the " + peer_ + " side (data plane)", microseconds(0));
+      transport_->poll(items, timeout);
+      if (items[0].ready) {
+        auto envelope = data_->receive("the " + peer_ + " side (data plane)", microseconds(0));
         if (!envelope) continue;
         check_frame(*envelope, expected);
         model_.receive(envelope->data());  // validates the frame (throws ProtocolError)
         if (log_) log_->write(envelope->data());
         return;
       }
-      if (items[1].revents & ZMQ_POLLIN) {
+      if (items[1].ready) {
         watch_coupler("for data from the " + peer_ + " side");
         continue;
       }
@@ -414,7 +391,7 @@ class SideRuntime {
 
   // ---------------------------------------------------------------- faults
   void inject_fault(std::uint64_t step) {
-    if (act_on_fault(options_.fault, step, role_, control_, data_ ? &*data_ : nullptr)) poison_next_frame_ = true;
+    if (act_on_fault(options_.fault, step, role_, *control_, data_.get())) poison_next_frame_ = true;
   }
 
  public:
@@ -424,11 +401,9 @@ class SideRuntime {
  private:
   SideModel& model_;
   SideOptions options_;
-  std::unique_ptr<zmq::context_t> own_context_;
-  zmq::context_t& context_;
-  zmq::socket_t control_;
-  std::unique_ptr<ZapAuthenticator> zap_;  // before data_: outlives the socket it guards
-  std::optional<zmq::socket_t> data_;
+  std::shared_ptr<Transport> transport_;  // before the links: outlives them
+  std::unique_ptr<Link> control_;
+  std::unique_ptr<Link> data_;  // with a peer only
   std::string role_, peer_;
   protocol::Welcome welcome_;
   std::unique_ptr<HeartbeatThread> heartbeat_;
@@ -438,10 +413,8 @@ class SideRuntime {
   Clock::time_point last_from_coupler_ = Clock::now();
   microseconds heartbeat_timeout_{3'000'000};
   microseconds spin_{0};
-  std::uint32_t exchange_interval_ = 1;
-  bool waits_first_ = false;      // this side consumes the peer's frame of a step before stepping
-  double publish_compute_s_ = 0;  // s in model_.publish since the last StepReport
-  bool has_peer_ = false;
+  std::optional<CouplingScheme> scheme_;  // from the Welcome: the order of steps, sends and waits
+  double publish_compute_s_ = 0;          // s in model_.publish since the last StepReport
   bool poison_next_frame_ = false;
   bool set_up_ = false;
   std::uint64_t step_ = 0;

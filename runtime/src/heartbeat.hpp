@@ -1,5 +1,5 @@
 // Private to the side runtime: the thread that sends a side's heartbeats on
-// its own socket, so the coupler hears from the side while it computes.
+// its own link, so the coupler hears from the side while it computes.
 #pragma once
 
 #include <atomic>
@@ -10,10 +10,9 @@
 #include <optional>
 #include <string>
 #include <thread>
-#include <zmq.hpp>
 
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/transport.hpp"
 
 namespace hfmpm::coupling {
 
@@ -24,15 +23,11 @@ constexpr double kFirstHeartbeatIntervalS = 0.1;
 // Sends Heartbeat on its own socket at an interval until stopped.
 class HeartbeatThread {
  public:
-  HeartbeatThread(zmq::context_t& context, const std::string& endpoint, protocol::Role role,
+  HeartbeatThread(Transport& transport, const std::string& endpoint, protocol::Role role,
                   const std::atomic<std::uint64_t>& step, const std::atomic<bool>& waiting,
                   const std::optional<CurveKeys>& curve)
-      : thread_([this, &context, endpoint, role, &step, &waiting, curve] {
-          zmq::socket_t socket(context, zmq::socket_type::dealer);
-          socket.set(zmq::sockopt::linger, 0);
-          socket.set(zmq::sockopt::routing_id, std::string(proto::role_name(role)) + ".hb");
-          if (curve) make_curve_client(socket, curve->server_public, curve->client_public, curve->client_secret);
-          socket.connect(endpoint);
+      : thread_([this, &transport, endpoint, role, &step, &waiting, curve] {
+          const auto link = transport.connect_heartbeat(endpoint, role, curve);
           std::uint64_t sequence = 0;
           std::unique_lock lock(mutex_);
           while (!stop_) {
@@ -42,7 +37,7 @@ class HeartbeatThread {
             beat->set_sequence(++sequence);
             beat->set_step(step.load());
             beat->set_waiting_for_peer(waiting.load());
-            (void)socket.send(zmq::buffer(proto::encode(envelope)), zmq::send_flags::dontwait);
+            (void)link->send_bytes(proto::encode(envelope), false);
             wake_.wait_for(lock, std::chrono::duration<double>(interval_s_.load()), [this] { return stop_; });
           }
         }) {}

@@ -6,7 +6,7 @@
 #include <string>
 #include <thread>
 
-#include "hfmpm/coupling/side_runtime.hpp"
+#include "hfmpm/runtime/side_runtime.hpp"
 #include "side_checks.hpp"
 
 namespace hfmpm::coupling {
@@ -42,8 +42,7 @@ Fault Fault::parse(const std::string& text) {
   return fault;
 }
 
-bool act_on_fault(const Fault& fault, std::uint64_t step, const std::string& role, zmq::socket_t& control,
-                  zmq::socket_t* data) {
+bool act_on_fault(const Fault& fault, std::uint64_t step, const std::string& role, Link& control, Link* data) {
   if (fault.kind == Fault::Kind::None || fault.step != step) return false;
   std::cerr << role << ": injecting fault at step " << step << "\n";
   switch (fault.kind) {
@@ -59,8 +58,8 @@ bool act_on_fault(const Fault& fault, std::uint64_t step, const std::string& rol
     case Fault::Kind::Garbage: {
       static constexpr char kGarbage[] = "\xff\x01garbage\x00\x7f not an envelope";
       const std::string garbage(kGarbage, sizeof(kGarbage) - 1);
-      (void)control.send(zmq::buffer(garbage), zmq::send_flags::none);
-      if (data) (void)data->send(zmq::buffer(garbage), zmq::send_flags::none);
+      (void)control.send_bytes(garbage, true);
+      if (data) (void)data->send_bytes(garbage, true);
       return false;
     }
     case Fault::Kind::NaN:

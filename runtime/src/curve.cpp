@@ -1,6 +1,6 @@
-#include "hfmpm/coupling/curve.hpp"
+#include "hfmpm/runtime/curve.hpp"
 
-#include "hfmpm/coupling/transport.hpp"
+#include "hfmpm/runtime/transport.hpp"
 
 #include <sys/stat.h>
 #include <zmq.h>

@@ -10,11 +10,11 @@
 #include <optional>
 #include <string>
 #include <vector>
-#include <zmq.hpp>
 
-#include "hfmpm/coupling/curve.hpp"
 #include "hfmpm/exchange.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "hfmpm/runtime/curve.hpp"
+#include "hfmpm/runtime/transport.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {
@@ -61,7 +61,7 @@ struct SideOptions {
   std::string advertise_host;                                       // tcp: host the peer can reach this side at
   std::string output_dir;                                           // overrides the coupler's output_dir
   double welcome_timeout_s = 60;                                    // the coupler must answer Hello within this
-  zmq::context_t* context = nullptr;                                // shared context (in-process mode); own one if null
+  std::shared_ptr<Transport> transport;                             // shared (in-process sides); ZeroMQ's if null
   std::uint32_t protocol_version = proto::kProtocolVersion;         // tests claim others
   std::uint32_t scene_schema_version = proto::kSceneSchemaVersion;  // tests claim others
   Fault fault;
