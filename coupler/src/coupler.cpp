@@ -2,6 +2,8 @@
 // run as a whole, and shutdown. See coupler_session.hpp for the parts.
 #include <google/protobuf/util/json_util.h>
 
+#include <cstdlib>
+
 #include "coupler_session.hpp"
 
 namespace hfmpm::coupling {
@@ -320,6 +322,15 @@ void Coupler::launch_sides() {
     args.insert(args.end(), extra.begin(), extra.end());
     side.log_path = output_dir_ + "/" + side.name + ".log";
     const std::string program = program_for(side);
+    // The sides' OpenMP threads sleep at a barrier instead of spinning
+    // (docs/performance.md, "Waiting without spinning"): the solid, the fluid
+    // and the coupler share the cores, and a spinning thread takes the core
+    // a descheduled partner needs (kgd-viscosity-ci's solid took 4.5 times
+    // as long spinning on a loaded 2-core machine). A user's own
+    // OMP_WAIT_POLICY or GOMP_SPINCOUNT is kept. Set before fork: the
+    // runtime reads it when the side starts.
+    if (!std::getenv("OMP_WAIT_POLICY") && !std::getenv("GOMP_SPINCOUNT")) setenv("OMP_WAIT_POLICY", "passive", 0);
+    if (const char* policy = std::getenv("OMP_WAIT_POLICY")) manifest_.set("omp_wait_policy", policy);
     try {
       side.process = std::make_unique<ChildProcess>(program, args, side.log_path);
     } catch (const std::exception& e) {
