@@ -194,6 +194,54 @@ TEST(KgdScene, ToughnessCiSceneFollowsTheKVertex) {
                           [](double t) { return k_vertex(1e7, 0.25, 25e3, 8.3e-4, t); });
 }
 
+// The paper's set-up in its own units with water (issue 19):
+// scenarios/kgd-paper-field-ci.scene (E = 20 GPa, 1 MPa, water K = 2 GPa,
+// mu = 1e-4 Pa s, 1e-5 m^2/s into the wing ramped over 5 s, h = 2 m, 300 s,
+// the implicit scheme at the solid's step). From three notch lengths on (the
+// 4 m notch), the mouth opening within the CI 10% of the M-vertex and the net
+// inlet pressure within 20% (measured 3.2% and 7.2%); the fluid front within
+// 20% at every row (15.5% at 110 s: the notch starts the crack with length
+// and no volume) and within 10% at the end (5.8%), where the tip may lead it
+// by the zero-lag closure's wait and a growth step (the tip is printed, not
+// asserted: 29% at 110 s, 11% at 300 s). The water's volume (sum of l w) is
+// the injected volume plus the notch's virtual film within 1%: its
+// compression p / K ~ 5e-4, and a partly filled front particle counts the
+// empty part of its domain (measured 0.99947 to 1.0082, the
+// largest at 30 s while the volume is small).
+TEST(KgdScene, FieldScaleWaterCiSceneFollowsTheMVertex) {
+  const auto out = scratch_dir("kgd_field_ci");
+  const auto result =
+      run_scene(read_file(source("scenarios/kgd-paper-field-ci.scene")), out, {"--set", "output.hdf5=false"}, 900);
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const Csv h = read_csv(out + "/history.csv");
+  const auto t = h.values("time_s"), tip = h.values("crack_length_m"), mouth = h.values("mouth_opening_m");
+  const auto p_in = h.values("inlet_pressure_pa"), front = h.values("front_position_m");
+  const auto injected = h.values("injected_volume_m2"), volume = h.values("fluid_volume_m2");
+  ASSERT_NEAR(t.back(), 300, 0.05);  // the run ends on a whole step (dt = 0.024 s)
+  constexpr double kSigma0 = 1e6, kNotch = 4, kRamp = 5, kQ = 2e-5, kFilm = kNotch * 2e-6;
+  int compared = 0;
+  double e_front_last = 1;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] > 10) {
+      const double ratio = volume[i] / (injected[i] + kFilm);
+      EXPECT_NEAR(ratio, 1.0, 1e-2) << "t = " << t[i];
+    }
+    if (front[i] < 3 * kNotch) continue;
+    const Vertex v = m_vertex(2e10, 0.25, 1e-4, kQ, t[i] - 0.5 * kRamp);
+    const double e_front = front[i] / v.length - 1, e_tip = tip[i] / v.length - 1;
+    const double e_opening = mouth[i] / v.opening - 1, e_pressure = (p_in[i] - kSigma0) / v.pressure - 1;
+    std::printf("t %.0f s: front %+.3f (tip %+.3f), mouth opening %+.3f, net inlet pressure %+.3f\n", t[i], e_front,
+                e_tip, e_opening, e_pressure);
+    EXPECT_LT(std::abs(e_opening), 0.10) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_pressure), 0.20) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_front), 0.20) << "t = " << t[i];
+    e_front_last = e_front;
+    ++compared;
+  }
+  EXPECT_LT(std::abs(e_front_last), 0.10);
+  EXPECT_GE(compared, 10);
+}
+
 // The implicit interface scheme (coupling.scheme IMPLICIT, issue 17) on the
 // CI viscosity scene at its own step: the answer no longer depends on how
 // stiff the fluid is. At K = 2e7 Pa and water (2e9 Pa), from three notch
