@@ -184,7 +184,7 @@ class FluidSolver {
   // compressed that far (J < 1 - c ln(1 + 1/c), 0.78 for water) is outside
   // any equation of state, and the step that did it has failed.
   void check_compression() const;
-  // output.cpp
+  // nodal_pressure.cpp
   void project_pressure();
   // Nodal pressures from particle pressures `pp` (the mass-weighted CPDI
   // projection with the front, lag and boundary rules; see nodal_pressure()).

@@ -1,4 +1,6 @@
-// Initial fill, nodal pressures and what the fluid reports.
+// The fluid's nodal pressure (the one the solid's faces carry) and what the
+// fluid reports from it: the projection with the front and lag rules, the
+// stiffness -dp/dw, the front, the messages; and the initial fill.
 #include <algorithm>
 #include <cmath>
 #include <sstream>
