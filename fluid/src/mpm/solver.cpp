@@ -286,15 +286,19 @@ void FluidSolver::p2g() {
 }
 
 void FluidSolver::check_compression() const {
-  const double K = config_.bulk_modulus;
+  // A failed solve, not a modelling limit: the soft stand-in fluids of the
+  // lab-scale scenes pass their bulk modulus for a few steps at the start
+  // (the toughness KGD's 2 MPa fluid reaches 1.01 K at 0.01 s) and recover.
+  const double K = config_.bulk_modulus, limit = kCompressionLimit * K;
   for (std::size_t p = 0; p < particles_.size(); ++p) {
-    if (!(particles_.pressure[p] <= K)) {
+    if (!(particles_.pressure[p] <= limit)) {
       std::ostringstream out;
       out << "fluid: crack " << grid_.crack_id() << ": at t = " << t_ << " s the fluid at s = " << particles_.s[p]
-          << " m is compressed to p = " << particles_.pressure[p] << " Pa, above its bulk modulus " << K
-          << " Pa (volume ratio below " << eos_.volume_ratio(K)
-          << "): no liquid's equation of state holds there, and the step that did it has failed (a step too "
-             "large for the coupling, or fluid trapped in a crack that closes)";
+          << " m is compressed to p = " << particles_.pressure[p] << " Pa, above " << kCompressionLimit
+          << " times its bulk modulus " << K << " Pa (volume ratio below " << eos_.volume_ratio(limit)
+          << "): the step that did it has failed: a coupled step too large (time.safety_factor; "
+             "coupling.scheme: IMPLICIT), or fluid trapped in a crack closed to too little room "
+             "(fluid.mpm.virtual_opening_m)";
       throw std::runtime_error(out.str());
     }
   }

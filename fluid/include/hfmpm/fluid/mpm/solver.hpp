@@ -180,9 +180,10 @@ class FluidSolver {
   void split_inlet();
   void merge(std::size_t p);  // merge particle p + 1 into p
   void merge_short();         // see FluidConfig::merge_fraction
-  // Throws when a particle's pressure exceeds the bulk modulus: a liquid
-  // compressed that far (J < 1 - c ln(1 + 1/c), 0.78 for water) is outside
-  // any equation of state, and the step that did it has failed.
+  // Throws when a particle's pressure exceeds kCompressionLimit x the bulk
+  // modulus (J < 0.37 for c = 0.0894): no coupled solution compresses a
+  // liquid to a third of its volume, so the step that did it has failed.
+  static constexpr double kCompressionLimit = 100;
   void check_compression() const;
   // nodal_pressure.cpp
   void project_pressure();
