@@ -297,6 +297,18 @@ std::string Coupler::program_for(const Side& side) const {
 
 void Coupler::launch_sides() {
   const bool inproc = scene_.coupling().transport() == scene::Coupling::INPROC;
+  // The sides' OpenMP threads sleep at a barrier instead of spinning
+  // (docs/performance.md, "Waiting without spinning"): the solid, the fluid
+  // and the coupler share the cores, and a spinning thread takes the core
+  // a descheduled partner needs (kgd-viscosity-ci's solid took 4.5 times
+  // as long spinning on a loaded 2-core machine). A user's own
+  // OMP_WAIT_POLICY or GOMP_SPINCOUNT is kept. Set before any fork: the
+  // runtime reads it when the side starts (in-process sides share the
+  // coupler's runtime, which has read it already).
+  if (!inproc) {
+    if (!std::getenv("OMP_WAIT_POLICY") && !std::getenv("GOMP_SPINCOUNT")) setenv("OMP_WAIT_POLICY", "passive", 0);
+    if (const char* policy = std::getenv("OMP_WAIT_POLICY")) manifest_.set("omp_wait_policy", policy);
+  }
   for (auto& side : sides_) {
     if (!side.expected) continue;
     if (inproc) {
@@ -322,15 +334,6 @@ void Coupler::launch_sides() {
     args.insert(args.end(), extra.begin(), extra.end());
     side.log_path = output_dir_ + "/" + side.name + ".log";
     const std::string program = program_for(side);
-    // The sides' OpenMP threads sleep at a barrier instead of spinning
-    // (docs/performance.md, "Waiting without spinning"): the solid, the fluid
-    // and the coupler share the cores, and a spinning thread takes the core
-    // a descheduled partner needs (kgd-viscosity-ci's solid took 4.5 times
-    // as long spinning on a loaded 2-core machine). A user's own
-    // OMP_WAIT_POLICY or GOMP_SPINCOUNT is kept. Set before fork: the
-    // runtime reads it when the side starts.
-    if (!std::getenv("OMP_WAIT_POLICY") && !std::getenv("GOMP_SPINCOUNT")) setenv("OMP_WAIT_POLICY", "passive", 0);
-    if (const char* policy = std::getenv("OMP_WAIT_POLICY")) manifest_.set("omp_wait_policy", policy);
     try {
       side.process = std::make_unique<ChildProcess>(program, args, side.log_path);
     } catch (const std::exception& e) {
