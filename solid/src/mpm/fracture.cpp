@@ -91,15 +91,18 @@ DomainWeight domain_weight(double x1, double x2, double ri, double ro) {
 constexpr double kPi = std::numbers::pi;
 
 // Williams' near-tip field of unit K in plane strain, in the tip frame at
-// polar coordinates (r, theta) about the tip: stress and du_i/dx1.
+// polar coordinates (r, theta) about the tip: stress, displacement and its
+// gradient du_i/dx_j.
 struct NearTipField {
   double s11 = 0, s22 = 0, s12 = 0;
-  double u11 = 0, u21 = 0;
+  double u1 = 0, u2 = 0;
+  double u11 = 0, u21 = 0, u12 = 0, u22 = 0;  // du_i/dx_j
 };
 
 // [0]: mode I (K_I = 1), [1]: mode II (K_II = 1). With u = sqrt(r / 2 pi) F(theta) / 2 mu,
 //   du/dx1 = cos(theta) du/dr - sin(theta) / r du/dtheta
-//          = (cos(theta) F / 2 - sin(theta) F') / (2 mu sqrt(2 pi r)).
+//          = (cos(theta) F / 2 - sin(theta) F') / (2 mu sqrt(2 pi r)),
+//   du/dx2 = (sin(theta) F / 2 + cos(theta) F') / (2 mu sqrt(2 pi r)).
 // Valid for any theta (continued past +-pi behind a curved crack).
 std::array<NearTipField, 2> williams(double r, double theta, double mu, double kappa) {
   const double s = std::sin(theta / 2), c = std::cos(theta / 2);
@@ -107,20 +110,24 @@ std::array<NearTipField, 2> williams(double r, double theta, double mu, double k
   const double st = 2 * s * c, ct = c * c - s * s;                  // sin, cos(theta)
   const double f = 1 / std::sqrt(2 * kPi * r), g = f / (2 * mu);
   std::array<NearTipField, 2> out;
-  auto gradient = [&](NearTipField& a, double f1, double d1, double f2, double d2) {
+  auto displacement = [&](NearTipField& a, double f1, double d1, double f2, double d2) {
+    a.u1 = g * r * f1;
+    a.u2 = g * r * f2;
     a.u11 = g * (0.5 * ct * f1 - st * d1);
     a.u21 = g * (0.5 * ct * f2 - st * d2);
+    a.u12 = g * (0.5 * st * f1 + ct * d1);
+    a.u22 = g * (0.5 * st * f2 + ct * d2);
   };
   out[0].s11 = f * c * (1 - s * s3);
   out[0].s22 = f * c * (1 + s * s3);
   out[0].s12 = f * s * c * c3;
-  gradient(out[0], c * (kappa - 1 + 2 * s * s), -0.5 * s * (kappa - 1 + 2 * s * s) + 2 * s * c * c,  //
-           s * (kappa + 1 - 2 * c * c), 0.5 * c * (kappa + 1 - 2 * c * c) + 2 * s * s * c);
+  displacement(out[0], c * (kappa - 1 + 2 * s * s), -0.5 * s * (kappa - 1 + 2 * s * s) + 2 * s * c * c,  //
+               s * (kappa + 1 - 2 * c * c), 0.5 * c * (kappa + 1 - 2 * c * c) + 2 * s * s * c);
   out[1].s11 = -f * s * (2 + c * c3);
   out[1].s22 = f * s * c * c3;
   out[1].s12 = f * c * (1 - s * s3);
-  gradient(out[1], s * (kappa + 1 + 2 * c * c), 0.5 * c * (kappa + 1 + 2 * c * c) - 2 * s * s * c,  //
-           -c * (kappa - 1 - 2 * s * s), 0.5 * s * (kappa - 1 - 2 * s * s) + 2 * s * c * c);
+  displacement(out[1], s * (kappa + 1 + 2 * c * c), 0.5 * c * (kappa + 1 + 2 * c * c) - 2 * s * s * c,  //
+               -c * (kappa - 1 - 2 * s * s), 0.5 * s * (kappa - 1 - 2 * s * s) + 2 * s * c * c);
   return out;
 }
 
@@ -143,32 +150,21 @@ std::vector<TipResult> Solver::tips() const {
   return out;
 }
 
-// The tip frame: x1 along the crack's direction over the J domain's inner
-// radius (the chord from the crack point ri behind the tip), not the last
-// segment's. The domain integral sees the crack at that scale: just after a
-// kink the segment points along the kink, the K_II measured in its frame is
-// still the unkinked crack's, and a second kink from the segment counted the
-// first one twice (hydraulic fractures beside an interface spiralled,
-// scenarios/layered.scene at 1e-3 Pa s). For a straight crack the same.
-Solver::TipFrame Solver::tip_frame(const Crack& crack, bool at_end, double ri) {
+// The tip frame: x1 along the last segment, the crack's direction at the
+// tip. The interaction integral's auxiliary fields are a straight crack's
+// along x1; where the crack bends inside the domain (a kink a few growth
+// steps back) its faces off the x1 axis carry the auxiliary field's traction,
+// which face_work adds. (Before, the frame was the chord over the J domain's
+// inner radius, without that face term: after a kink the K's were the
+// unkinked crack's, seen in a frame turning with the branch, and the path
+// overshot the kink by 6 deg over the next 6 steps before turning back.)
+Solver::TipFrame Solver::tip_frame(const Crack& crack, bool at_end) {
   const std::size_t n = crack.size();
-  auto at = [&](std::size_t i) { return at_end ? i : n - 1 - i; };  // from the far end to the tip
   TipFrame f;
   f.at_end = at_end;
   f.up = at_end ? 1 : -1;
-  f.position = crack.plane()[at(n - 1)];
-  Vec2 back = crack.plane()[at(0)];
-  double along = 0;
-  for (std::size_t i = n - 1; i > 0; --i) {
-    const Vec2& a = crack.plane()[at(i)];
-    const Vec2& b = crack.plane()[at(i - 1)];
-    const double len = (b - a).norm();
-    if (along + len >= ri) {
-      back = a + (ri - along) / len * (b - a);
-      break;
-    }
-    along += len;
-  }
+  f.position = at_end ? crack.plane()[n - 1] : crack.plane()[0];
+  const Vec2& back = at_end ? crack.plane()[n - 2] : crack.plane()[1];
   f.e1 = (f.position - back).normalized();
   f.e2 = Vec2(-f.e1.y(), f.e1.x());
   f.rot.row(0) = f.e1.transpose();
@@ -289,32 +285,129 @@ Solver::TipSums Solver::domain_integrals(const Crack& crack, const TipFrame& f, 
   return sums;
 }
 
-// Work of the face loads: -integral q (p n + sigma0 n) . d[u]/dx1 ds for J,
-// and the same with the auxiliary jump for m1, m2 (8 sqrt(r / 2 pi) / E'
-// along e2 in mode I, along e1 in mode II).
-Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double ri, double ro, double modulus) const {
+// The crack faces inside the domain, for J and m1, m2: with t the traction
+// on the body at a face, n^A its outward normal (into the gap) and the sums
+// over the two faces of each segment,
+//   J:   - integral q sum (t . u,1 - W n^A_1) ds,
+//   M_a: - integral q sum (t . ua,1 + ta . u,1 - sa_ik u_i,k n^A_1) ds.
+// With load = t on the +x2 face (p n + sigma0 n, n the normal towards that
+// face), s the segment's direction towards the tip, s1 = s . e1, n1 = n . e1:
+// - J: - q (load . (s1 d[u]/ds + n1 d[u]/dn) + n1 (W+ - W-)), [u] the jump
+//   (+x2 face less the other); d[u]/ds from the surfaces, d[u]/dn and W from
+//   the nearest particle of each side (they carry their side's field).
+// - M_a: the auxiliary field is cut along the crack (theta continued past
+//   +-pi as for the particles), so ua, sa on the +x2 face are minus those on
+//   the other (the half-angle functions change sign over 2 pi). Then
+//   - q load . (s1 d[ua]/ds + n1 d[ua]/dn) - 2 q A . d(mean u)/ds, with
+//   A = (sa- n) s1 - (sa- s) n1 (sa- the auxiliary stress on the -x2 face):
+//   the normal derivatives of u cancel in ta . u,1 - sa_ik u_i,k n^A_1, and
+//   the jump's part cancels between the faces, leaving the mean face
+//   displacement's tangential gradient, d(mean u)/ds = (grad u+ + grad u-) s / 2
+//   from the nearest particles.
+// On the x1 axis behind the tip (a straight crack; the last segment always)
+// n1 = 0 and sa n = 0: only load . d[ua]/ds, [ua] = 8 sqrt(r / 2 pi) / E'
+// along e2 (mode I) or e1 (mode II), exact over each segment from its ends;
+// the off-axis terms by 4-point Gauss quadrature over each segment. Left out,
+// these are what made the K's after a kink wrong: the auxiliary field's
+// traction on the crack before the kink (at theta = -127 deg in the frame of
+// a 53-deg kink) is of the order of its stress.
+Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double ri, double ro,
+                                  std::size_t material) const {
+  const double mu = shear_[material], lambda = lambda_[material];
+  const double kappa = 3 - 4 * lambda / (2 * (lambda + mu));  // 3 - 4 nu
+  const double h = config_.grid.h;
   const std::size_t n = crack.size();
   auto at = [&](std::size_t i) { return f.at_end ? i : n - 1 - i; };
   auto jump = [&](std::size_t k) -> Vec2 { return crack.surface(f.up)[k] - crack.surface(-f.up)[k]; };
-  auto aux_jump = [&](std::size_t k) {
-    return 8 * std::sqrt((crack.plane()[k] - f.position).norm() / (2 * kPi)) / modulus;
+  // The auxiliary fields at a point of the crack on its +x2 face (face > 0)
+  // or the other: theta continued past +-pi as for the particles.
+  auto aux_at = [&](const Vec2& x, int face) {
+    const Vec2 d = x - f.position;
+    const double x1 = d.dot(f.e1), x2 = d.dot(f.e2);
+    double theta = std::atan2(x2, x1);
+    if (theta < -kPi / 2) theta += 2 * kPi;
+    if (face < 0) theta -= 2 * kPi;
+    return williams(std::hypot(x1, x2), theta, mu, kappa);
   };
+  // [ua] = 2 ua(+x2 face), tip frame, per mode.
+  auto aux_jump = [&](const Vec2& x) -> std::array<Vec2, 2> {
+    if (!((x - f.position).norm() > 0)) return {Vec2::Zero(), Vec2::Zero()};
+    const auto a = aux_at(x, 1);
+    return {Vec2(2 * a[0].u1, 2 * a[0].u2), Vec2(2 * a[1].u1, 2 * a[1].u2)};
+  };
+  // The particles near the domain and their sides (+1: the +x2 side).
+  const CrackSide side(crack, f.position, 2.2 * ro + 2 * h, f.up);
+  std::vector<std::size_t> near;
+  std::vector<int> near_side;
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const Vec2 d = particles_.x[p] - f.position;
+    if (std::abs(d.x()) >= ro * 1.5 + h || std::abs(d.y()) >= ro * 1.5 + h) continue;
+    near.push_back(p);
+    near_side.push_back(side(particles_.x[p]));
+  }
+  // The displacement gradient (tip frame) of the particle nearest x on one side.
+  auto gradient_at = [&](const Vec2& x, int face) -> Eigen::Matrix2d {
+    double best = kForever;
+    std::size_t found = particles_.size();
+    for (std::size_t i = 0; i < near.size(); ++i) {
+      const double dist = (particles_.x[near[i]] - x).squaredNorm();
+      if (near_side[i] == face && dist < best) {
+        best = dist;
+        found = near[i];
+      }
+    }
+    if (found == particles_.size()) return Eigen::Matrix2d::Zero();
+    return f.rot * particles_.grad_u[found] * f.rot.transpose();
+  };
+  auto energy = [&](const Eigen::Matrix2d& g) {
+    const Eigen::Matrix2d e = 0.5 * (g + g.transpose());
+    return 0.5 * lambda * e.trace() * e.trace() + mu * (e.array() * e.array()).sum();
+  };
+  static constexpr std::array<double, 4> kGaussX = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
+                                                    0.8611363115940526};
+  static constexpr std::array<double, 4> kGaussW = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
+                                                    0.3478548451374538};
   TipSums sums;
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const std::size_t a = at(i), b = at(i + 1);
-    const Vec2 mid = 0.5 * (crack.plane()[a] + crack.plane()[b]);
+    const Vec2& pa = crack.plane()[a];
+    const Vec2& pb = crack.plane()[b];
+    const double len = (pb - pa).norm();
+    if (!(len > 0)) continue;
+    const Vec2 mid = 0.5 * (pa + pb);
     const Vec2 d = mid - f.position;
     const double q = domain_weight(d.dot(f.e1), d.dot(f.e2), ri, ro).q;
-    if (q == 0) continue;
-    const Vec2 t = (crack.plane()[b] - crack.plane()[a]).normalized();
+    const Vec2 t = (pb - pa) / len;
     const Vec2 n_up(-t.y(), t.x());
     Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
-    const Voigt s0 = in_situ_stress(mid);
-    load += traction(s0, n_up);
-    sums.j -= q * load.dot(jump(b) - jump(a));
-    const double step = aux_jump(b) - aux_jump(a);
-    sums.m1 -= q * load.dot(f.e2) * step;
-    sums.m2 -= q * load.dot(f.e1) * step;
+    load += traction(in_situ_stress(mid), n_up);
+    const Vec2 load_f = f.rot * load, s_f = f.rot * t, n_f = f.rot * n_up;  // tip frame
+    const auto ja = aux_jump(pa), jb = aux_jump(pb);
+    if (q > 0) {
+      sums.j -= q * s_f.x() * load.dot(jump(b) - jump(a));
+      sums.m1 -= q * s_f.x() * load_f.dot(jb[0] - ja[0]);
+      sums.m2 -= q * s_f.x() * load_f.dot(jb[1] - ja[1]);
+    }
+    if (b == at(n - 1)) continue;  // the last segment: on the x1 axis
+    const Eigen::Matrix2d g_up = gradient_at(mid, 1), g_down = gradient_at(mid, -1);
+    if (q > 0) sums.j -= q * len * n_f.x() * (load_f.dot((g_up - g_down) * n_f) + energy(g_up) - energy(g_down));
+    const Vec2 du_mean = 0.5 * (g_up + g_down) * s_f;  // d(mean u)/ds
+    for (std::size_t gp = 0; gp < kGaussX.size(); ++gp) {
+      const Vec2 x = pa + 0.5 * (1 + kGaussX[gp]) * (pb - pa);
+      const Vec2 dx = x - f.position;
+      const double w = 0.5 * len * kGaussW[gp] * domain_weight(dx.dot(f.e1), dx.dot(f.e2), ri, ro).q;
+      if (w == 0) continue;
+      const auto up = aux_at(x, 1), down = aux_at(x, -1);
+      for (std::size_t mode = 0; mode < 2; ++mode) {
+        const NearTipField& u = up[mode];
+        const NearTipField& l = down[mode];
+        const Vec2 dn(2 * (u.u11 * n_f.x() + u.u12 * n_f.y()), 2 * (u.u21 * n_f.x() + u.u22 * n_f.y()));  // d[ua]/dn
+        Eigen::Matrix2d sa;
+        sa << l.s11, l.s12, l.s12, l.s22;
+        const Vec2 aa = (sa * n_f) * s_f.x() - (sa * s_f) * n_f.x();
+        (mode == 0 ? sums.m1 : sums.m2) -= w * (n_f.x() * load_f.dot(dn) + 2 * aa.dot(du_mean));
+      }
+    }
   }
   return sums;
 }
@@ -325,7 +418,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
   const Crack& crack = cracks_[c];
   const double h = config_.grid.h;
   const double ri = config_.fracture.inner_cells * h, ro = config_.fracture.outer_cells * h;
-  const TipFrame frame = tip_frame(crack, at_end, ri);
+  const TipFrame frame = tip_frame(crack, at_end);
   TipResult tip;
   tip.crack = c;
   tip.at_end = at_end;
@@ -335,7 +428,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
   tip.modulus = config_.materials[tip.material].plane_strain_modulus();
   tip.toughness = config_.materials[tip.material].toughness;
   const TipSums area = domain_integrals(crack, frame, ri, ro, tip.material);
-  const TipSums faces = face_work(crack, frame, ri, ro, tip.modulus);
+  const TipSums faces = face_work(crack, frame, ri, ro, tip.material);
   tip.j = area.j + faces.j;
   tip.j_faces = faces.j;
   tip.k1 = tip.modulus * (area.m1 + faces.m1) / 2;

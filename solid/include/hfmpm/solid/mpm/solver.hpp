@@ -177,10 +177,10 @@ class Solver {
   struct TipSums {
     double j = 0, m1 = 0, m2 = 0;  // J and the interaction integrals
   };
-  static TipFrame tip_frame(const Crack& crack, bool at_end, double ri);
+  static TipFrame tip_frame(const Crack& crack, bool at_end);
   std::size_t material_at(const Vec2& x) const;
   TipSums domain_integrals(const Crack& crack, const TipFrame& frame, double ri, double ro, std::size_t material) const;
-  TipSums face_work(const Crack& crack, const TipFrame& frame, double ri, double ro, double modulus) const;
+  TipSums face_work(const Crack& crack, const TipFrame& frame, double ri, double ro, std::size_t material) const;
   TipResult evaluate_tip(std::size_t c, bool at_end) const;
   std::string runaway_report(std::size_t p, double dt) const;
   void update_feedback(double dt);
