@@ -293,8 +293,13 @@ Solver::TipSums Solver::domain_integrals(const Crack& crack, const TipFrame& f, 
 // With load = t on the +x2 face (p n + sigma0 n, n the normal towards that
 // face), s the segment's direction towards the tip, s1 = s . e1, n1 = n . e1:
 // - J: - q (load . (s1 d[u]/ds + n1 d[u]/dn) + n1 (W+ - W-)), [u] the jump
-//   (+x2 face less the other); d[u]/ds from the surfaces, d[u]/dn and W from
-//   the nearest particle of each side (they carry their side's field).
+//   (+x2 face less the other). Each face's gradient follows from its
+//   tangential gradient and its traction (sigma n = -load): with
+//   du/ds = d(mean u)/ds +- d[u]/ds / 2, e_ss = s . du/ds,
+//   e_nn = (s_nn - lambda e_ss) / (lambda + 2 mu), e_ns = s_ns / 2 mu,
+//   du/dn = (2 e_ns - n . du/ds) s + e_nn n; d[u]/ds from the surfaces,
+//   d(mean u)/ds from the nearest particle of each side (they carry their
+//   side's field).
 // - M_a: the auxiliary field is cut along the crack (theta continued past
 //   +-pi as for the particles), so ua, sa on the +x2 face are minus those on
 //   the other (the half-angle functions change sign over 2 pi). Then
@@ -359,10 +364,7 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
     if (found == particles_.size()) return Eigen::Matrix2d::Zero();
     return f.rot * particles_.grad_u[found] * f.rot.transpose();
   };
-  auto energy = [&](const Eigen::Matrix2d& g) {
-    const Eigen::Matrix2d e = 0.5 * (g + g.transpose());
-    return 0.5 * lambda * e.trace() * e.trace() + mu * (e.array() * e.array()).sum();
-  };
+
   static constexpr std::array<double, 4> kGaussX = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
                                                     0.8611363115940526};
   static constexpr std::array<double, 4> kGaussW = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
@@ -388,10 +390,25 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
       sums.m1 -= q * s_f.x() * load_f.dot(jb[0] - ja[0]);
       sums.m2 -= q * s_f.x() * load_f.dot(jb[1] - ja[1]);
     }
-    if (b == at(n - 1)) continue;  // the last segment: on the x1 axis
-    const Eigen::Matrix2d g_up = gradient_at(mid, 1), g_down = gradient_at(mid, -1);
-    if (q > 0) sums.j -= q * len * n_f.x() * (load_f.dot((g_up - g_down) * n_f) + energy(g_up) - energy(g_down));
-    const Vec2 du_mean = 0.5 * (g_up + g_down) * s_f;  // d(mean u)/ds
+    if (b == at(n - 1)) continue;                                                   // the last segment: on the x1 axis
+    const Vec2 du_mean = 0.5 * (gradient_at(mid, 1) + gradient_at(mid, -1)) * s_f;  // d(mean u)/ds
+    if (q > 0) {
+      // Each face's field from its tangential gradient and its traction
+      // (sigma n = -load on both faces, plane strain).
+      const Vec2 du_jump = f.rot * (jump(b) - jump(a)) / len;  // d[u]/ds
+      const double snn = -load_f.dot(n_f), sns = -load_f.dot(s_f);
+      double energy[2];
+      Vec2 du_dn[2];
+      for (int k = 0; k < 2; ++k) {
+        const Vec2 du_ds = du_mean + (k == 0 ? 0.5 : -0.5) * du_jump;
+        const double ess = s_f.dot(du_ds);
+        const double enn = (snn - lambda * ess) / (lambda + 2 * mu), ens = sns / (2 * mu);
+        const double sss = (lambda + 2 * mu) * ess + lambda * enn;
+        energy[k] = 0.5 * (sss * ess + snn * enn + 2 * sns * ens);
+        du_dn[k] = (2 * ens - n_f.dot(du_ds)) * s_f + enn * n_f;
+      }
+      sums.j -= q * len * n_f.x() * (load_f.dot(du_dn[0] - du_dn[1]) + energy[0] - energy[1]);
+    }
     for (std::size_t gp = 0; gp < kGaussX.size(); ++gp) {
       const Vec2 x = pa + 0.5 * (1 + kGaussX[gp]) * (pb - pa);
       const Vec2 dx = x - f.position;
