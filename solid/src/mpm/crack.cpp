@@ -22,9 +22,12 @@ Crack::Crack(std::uint32_t id, const CrackSpec& spec)
   for (const auto& p : spec.points) append(p);
 }
 
-void Crack::append(const Vec2& position) {
+void Crack::append(const Vec2& position) { append(position, position); }
+
+void Crack::append(const Vec2& position, const Vec2& reference) {
   ids_.push_back(next_id_++);
   plane_.push_back(position);
+  reference_.push_back(reference);
   above_.push_back(position);
   below_.push_back(position);
   pressure_.push_back(0.0);
@@ -32,11 +35,14 @@ void Crack::append(const Vec2& position) {
   reference_width_.push_back(0.0);
 }
 
-void Crack::prepend(const Vec2& position) {
-  append(position);  // then move the new last particle to the front
+void Crack::prepend(const Vec2& position) { prepend(position, position); }
+
+void Crack::prepend(const Vec2& position, const Vec2& reference) {
+  append(position, reference);  // then move the new last particle to the front
   auto to_front = [](auto& v) { std::rotate(v.rbegin(), v.rbegin() + 1, v.rend()); };
   to_front(ids_);
   to_front(plane_);
+  to_front(reference_);
   to_front(above_);
   to_front(below_);
   to_front(pressure_);

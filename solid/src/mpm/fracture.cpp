@@ -351,15 +351,22 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
     near_side.push_back(side(particles_.x[p]));
   }
   // The displacement gradient (tip frame) of the particle nearest x on one side.
-  auto gradient_at = [&](const Vec2& x, int face) -> Eigen::Matrix2d {
+  // A particle that started on the segment's line (within 1e-3 h, in the
+  // reference state) carries neither face's field: its side is a convention
+  // (the side tests count it above), and its gradient mixes both.
+  auto gradient_at = [&](const Vec2& x, int face, std::size_t a, std::size_t b) -> Eigen::Matrix2d {
+    const Vec2& ra = crack.reference()[a];
+    const Vec2 rt = (crack.reference()[b] - ra).normalized();
     double best = kForever;
     std::size_t found = particles_.size();
     for (std::size_t i = 0; i < near.size(); ++i) {
-      const double dist = (particles_.x[near[i]] - x).squaredNorm();
-      if (near_side[i] == face && dist < best) {
-        best = dist;
-        found = near[i];
-      }
+      const std::size_t p = near[i];
+      const double dist = (particles_.x[p] - x).squaredNorm();
+      if (near_side[i] != face || !(dist < best)) continue;
+      const Vec2 d = particles_.x[p] - particles_.displacement[p] - ra;
+      if (std::abs(d.x() * rt.y() - d.y() * rt.x()) < 1e-3 * h) continue;
+      best = dist;
+      found = p;
     }
     if (found == particles_.size()) return Eigen::Matrix2d::Zero();
     return f.rot * particles_.grad_u[found] * f.rot.transpose();
@@ -390,8 +397,8 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
       sums.m1 -= q * s_f.x() * load_f.dot(jb[0] - ja[0]);
       sums.m2 -= q * s_f.x() * load_f.dot(jb[1] - ja[1]);
     }
-    if (b == at(n - 1)) continue;                                                   // the last segment: on the x1 axis
-    const Vec2 du_mean = 0.5 * (gradient_at(mid, 1) + gradient_at(mid, -1)) * s_f;  // d(mean u)/ds
+    if (b == at(n - 1)) continue;  // the last segment: on the x1 axis
+    const Vec2 du_mean = 0.5 * (gradient_at(mid, 1, a, b) + gradient_at(mid, -1, a, b)) * s_f;  // d(mean u)/ds
     if (q > 0) {
       // Each face's field from its tangential gradient and its traction
       // (sigma n = -load on both faces, plane strain).
@@ -496,11 +503,25 @@ int Solver::propagate() {
     const Vec2 next = tip.position + config_.fracture.growth_cells * h * d;
     // Stop a cell short of the body's edge: the crack has run through.
     if ((next.array() < (body_lo_.array() + h)).any() || (next.array() > (body_hi_.array() - h)).any()) continue;
+    // The new particle's reference position (Crack::reference): the tip's,
+    // plus the step less the mean displacement gradient of the particles
+    // within a cell of it.
+    const Vec2 mid = 0.5 * (tip.position + next);
+    Eigen::Matrix2d gradient = Eigen::Matrix2d::Zero();
+    double count = 0;
+    for (std::size_t p = 0; p < particles_.size(); ++p) {
+      if ((particles_.x[p] - mid).squaredNorm() >= h * h) continue;
+      gradient += particles_.grad_u[p];
+      count += 1;
+    }
+    if (count > 0) gradient /= count;
     auto& crack = cracks_[tip.crack];
+    const Vec2& tip_reference = tip.at_end ? crack.reference().back() : crack.reference().front();
+    const Vec2 reference = tip_reference + (Eigen::Matrix2d::Identity() - gradient) * (next - tip.position);
     if (tip.at_end) {
-      crack.append(next);
+      crack.append(next, reference);
     } else {
-      crack.prepend(next);
+      crack.prepend(next, reference);
     }
     grown_at = t_;
     ++added;

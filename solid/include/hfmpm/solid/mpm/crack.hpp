@@ -25,6 +25,10 @@ class Crack {
   std::uint32_t id() const { return id_; }
   std::size_t size() const { return plane_.size(); }
   const std::vector<Vec2>& plane() const { return plane_; }
+  // Where each crack particle's plane point was in the reference state (the
+  // start): plane() less the faces' mean displacement. The crack's initial
+  // points are their own; a grown particle's is estimated when it is added.
+  const std::vector<Vec2>& reference() const { return reference_; }
   const std::vector<Vec2>& surface(int side) const { return side > 0 ? above_ : below_; }
   std::vector<Vec2>& surface(int side) { return side > 0 ? above_ : below_; }
   const std::vector<std::uint64_t>& ids() const { return ids_; }
@@ -65,17 +69,20 @@ class Crack {
   // Crack plane = midpoint of the surfaces (after the surfaces moved).
   void update_plane();
 
-  // Appends a crack particle at the end (growth); it starts closed.
+  // Appends a crack particle at the end (growth); it starts closed. Without
+  // a reference position: the position (a crack of the initial state).
   void append(const Vec2& position);
+  void append(const Vec2& position, const Vec2& reference);
   // Inserts a crack particle before the first (growth of a start tip; only
   // for cracks inside the body, which no fluid uses); it starts closed.
   void prepend(const Vec2& position);
+  void prepend(const Vec2& position, const Vec2& reference);
 
  private:
   std::uint32_t id_;
   bool start_is_tip_, end_is_tip_;
   std::vector<std::uint64_t> ids_;
-  std::vector<Vec2> plane_, above_, below_;
+  std::vector<Vec2> plane_, above_, below_, reference_;
   std::vector<double> pressure_;                     // Pa, on the faces, per crack particle
   std::vector<double> stiffness_, reference_width_;  // Pa/m and m, per crack particle
   double wetted_length_ = -1;
