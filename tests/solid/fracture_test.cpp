@@ -186,14 +186,17 @@ TEST(InclinedCrack, MixedModeAndKinkAngle) {
 }
 
 // After a kink the crack should go on in the kinked direction, not turn
-// again: the state above (the kinked segment just added, still closed, so the
-// field is the unkinked crack's) must give the same absolute growth direction
-// as before the kink. The tip frame is the crack's chord over J's inner radius
-// (docs/solid.md); measured in the last segment's frame instead, the same
-// field gave a second kink of about the first (-53 degrees again: -106 from
-// the crack), and fluid-driven cracks beside an interface spiralled. Asserted:
-// within 10 degrees of the first direction (the new tip is half a cell from
-// the singularity the domain sees, which shifts the measured K's).
+// again: the state above with the kinked segment just added (still closed,
+// not re-settled, so the field is the unkinked crack's) must give about the
+// same absolute growth direction as before the kink. The tip frame is the
+// last segment; the crack before the kink lies off its x1 axis, and the
+// interaction integral's face terms there (the auxiliary field's traction)
+// are what keep the second kink small: without them the same field gave a
+// second kink of about the first (-53 degrees again: -106 from the crack),
+// and fluid-driven cracks beside an interface spiralled. Asserted: within 10
+// degrees of the first direction (the field is not that of the kinked
+// crack, and the new tip is half a cell from the singularity the domain
+// sees; measured 6.7 deg).
 TEST(InclinedCrack, ASecondKinkDoesNotRepeatTheFirst) {
   const double h = kA / 5;
   SolidConfig c = inclined_crack(h);
