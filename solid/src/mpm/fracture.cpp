@@ -30,7 +30,9 @@
 //   M_a = sum_p V_p (sigma_ij ua_i,1 + sa_ij u_i,1 - sa_ik eps_ik delta_1j) q,j
 //         - integral over the faces q (p n + sigma0 n) . d[ua]/dx1 ds,
 // [ua] = ua(theta = pi) - ua(theta = -pi) = 8 sqrt(r / 2 pi) / E' along e2
-// (mode I) or e1 (mode II); the auxiliary faces carry no traction. Then
+// (mode I) or e1 (mode II); on the x1 axis behind the tip the auxiliary
+// faces carry no traction, on faces off it (a kink in the domain) they do,
+// and face_work adds that term (and J's -W n1). Then
 // M_a = 2 K_a / E', so K_I = E' M_1 / 2 and K_II = E' M_2 / 2, each linear
 // in the computed field. J stays the EDI above (the growth criterion);
 // K_I^2 + K_II^2 = E' J only to discretization error. Like J, M assumes one
