@@ -57,8 +57,8 @@ void print(const Growth& g) {
   std::printf(
       "  %s tip step %d at (%+.4f, %+.4f), t = %.5f s: J %.4e J/m^2 (faces %+.4e), J/((K_I^2+K_II^2)/E') %.4f, "
       "K_I %.4e, K_II/K_I %+.4f, kink %+.2f deg\n",
-      t.at_end ? "end  " : "start", t.at_end ? g.end_grown : g.start_grown, t.position.x(), t.position.y(), g.time,
-      t.j, t.j_faces, j_over_k(t), t.k1, t.k2 / t.k1, t.kink * 180 / kPi);
+      t.at_end ? "end  " : "start", t.at_end ? g.end_grown : g.start_grown, t.position.x(), t.position.y(), g.time, t.j,
+      t.j_faces, j_over_k(t), t.k1, t.k2 / t.k1, t.kink * 180 / kPi);
 }
 
 // Steps `solid` with the face pressure pressure(t) until `done` says so or
@@ -229,6 +229,8 @@ struct Turned {
   std::vector<Vec2> plane;
   std::size_t start_initial = 0, end_initial = 0;  // indices of the initial tips in plane
   double start_heading = 0, end_heading = 0;       // deg
+  int count_gap = 0;                               // largest difference of the tips' growth counts
+  double start_crossing = 0, end_crossing = 0;     // m, x where the start (end) tip's path crosses y = -1.5 (+1.5) m
 };
 
 // The 45-degree crack in sigma_xx = -2 MPa, sigma_yy = -6 MPa, pressurised
@@ -270,34 +272,51 @@ Turned turn_in_anisotropic_stress(double h, double length) {
   out.end_initial = out.start_initial + static_cast<std::size_t>(std::lround(4 * kA / h));
   out.start_heading = heading(out.plane, false, 2 * h);
   out.end_heading = heading(out.plane, true, 2 * h);
+  for (const auto& g : log) out.count_gap = std::max(out.count_gap, std::abs(g.start_grown - g.end_grown));
+  out.start_crossing = x_at_height(out.plane, false, -1.5);
+  out.end_crossing = x_at_height(out.plane, true, 1.5);
   std::printf(
       "h = a/%.0f: start tip grew %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = -1.5 m at "
       "x = %+.4f m; end tip %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = 1.5 m at x = %+.4f m\n",
-      kA / h, out.start_initial, out.plane.front().x(), out.plane.front().y(), out.start_heading,
-      x_at_height(out.plane, false, -1.5), out.plane.size() - 1 - out.end_initial, out.plane.back().x(),
-      out.plane.back().y(), out.end_heading, x_at_height(out.plane, true, 1.5));
+      kA / h, out.start_initial, out.plane.front().x(), out.plane.front().y(), out.start_heading, out.start_crossing,
+      out.plane.size() - 1 - out.end_initial, out.plane.back().x(), out.plane.back().y(), out.end_heading,
+      out.end_crossing);
+  const Vec2 centre(h / 2, 0);
+  std::printf(
+      "point symmetry about the centre (%.3f, 0): tips %.4f m apart from symmetric, crossings %.4f m; growth "
+      "counts differed by at most %d\n",
+      centre.x(), (out.plane.back() - centre + (out.plane.front() - centre)).norm(),
+      std::abs(out.end_crossing - centre.x() + (out.start_crossing - centre.x())), out.count_gap);
   return out;
 }
 
 // Stress ratio 3:1 (sigma_xx = -2 MPa, sigma_yy = -6 MPa): the crack turns
 // perpendicular to the least compression (sigma_xx), i.e. towards the y axis:
-// the end tip's heading to +90 deg, the start tip's to -90 deg. The crack is
-// shut when it first grows (the pressure is still below the 4 MPa normal
-// stress on it), so it kinks by the pure mode II angle, 70.5 deg, to a
-// heading of 115.5 deg, overshooting the final direction, and turns back over
-// the next growth steps as the pressure opens it. Asserted after 1.2 a of
-// growth (24 quarter-cell steps at a/5): both headings (the last 2 cells)
-// within 5 deg of +-90 (issue 18), and the two tips point-symmetric within
-// one growth step (a quarter cell; issue 18; measured: 1.5e-3 m, 0.008 h). HFMPM_OBLIQUE_CELLS=n runs at a/n.
+// the end tip's heading to +90 deg, the start tip's to -90 deg. The crack
+// first grows when the pressure has just passed the 4 MPa normal stress on
+// it (K_II about -5 K_I), so it kinks by about 67 deg to a heading of about
+// 112 deg, overshooting the final direction, and turns back over the next
+// growth steps. Asserted after 1.2 a of growth (24 quarter-cell steps at
+// a/5): both headings (the last 2 cells) within 5 deg of +-90 (issue 18);
+// point symmetry about the centre (h / 2, 0): the tips' growth counts never
+// differ by more than one (issue 18), the tips and the points where the
+// paths cross y = +-1.5 m symmetric within one growth step (a quarter cell).
+// After the first kink the growth criterion is G from the interaction
+// integral, not J (growth_energy): J there is 31-38% below
+// (K_I^2 + K_II^2)/E' also in a re-solve from rest, by different amounts at
+// the two tips, and with J the tips grew at different checks (docs/
+// verification.md). HFMPM_OBLIQUE_CELLS=n runs at a/n.
 TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {
   const int cells = std::getenv("HFMPM_OBLIQUE_CELLS") ? std::atoi(std::getenv("HFMPM_OBLIQUE_CELLS")) : 5;
   const double h = kA / cells;
   const Turned t = turn_in_anisotropic_stress(h, 1.2 * kA);
   EXPECT_NEAR(t.end_heading, 90, 5);
   EXPECT_NEAR(t.start_heading, -90, 5);
-  // Point symmetry about the crack's centre (h / 2, 0).
   const Vec2 centre(h / 2, 0);
-  EXPECT_LT((t.plane.back() - centre + (t.plane.front() - centre)).norm(), 0.25 * h);
+  const double step = 0.25 * h;
+  EXPECT_LE(t.count_gap, 1) << "the tips of a point-symmetric crack grew apart";
+  EXPECT_LT((t.plane.back() - centre + (t.plane.front() - centre)).norm(), step);
+  EXPECT_LT(std::abs(t.end_crossing - centre.x() + (t.start_crossing - centre.x())), step);
 }
 
 // The inclined centre crack (45 degrees) under remote tension sigma_yy grows
@@ -312,11 +331,13 @@ TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {
 // - the growth goes on past the kink, the first heading within 3 deg of
 //   -8.13 (as for the kink before growth), the two tips point-symmetric
 //   within one growth step;
-// - J/((K_I^2+K_II^2)/E') within 10% at every step (measured 0.979-1.089:
-//   1.082-1.089 at the two steps after the kink, where J's face term takes
-//   each face's field near the corner from a particle up to half a cell
-//   away; 0.979-1.043 from the 4th step on; before issue 18's face terms
-//   the tolerance was 8%, the K's of an oblique crack before growth);
+// - J/((K_I^2+K_II^2)/E') within 5% from the 4th step on, within 10% at
+//   the first three; at the end tip's first three checks the crack and the
+//   tension of the check are re-solved from rest (damped over 12 transits),
+//   and there J/((K_I^2+K_II^2)/E') must be within 7% of 1 and K_I within
+//   3% of the growth run's: the excess of J at the two steps after the kink
+//   is the motion the growth left (the dynamic term), the static J after
+//   the kink a few percent low (docs/verification.md has the figures);
 // - issue 18: from the 5th step on, every heading within 3 deg of the
 //   maximum-hoop-stress path computed from the K measured at each step (the
 //   first heading turned by the sum of the kinks measured since);
@@ -405,7 +426,11 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
       EXPECT_GT(last, headings.front() / 2) << "the path does not turn towards 0";
     }
   }
-  for (const auto& g : log) EXPECT_NEAR(j_over_k(g.tip), 1, 0.10) << (g.tip.at_end ? "end" : "start") << " tip";
+  for (const auto& g : log) {
+    const int step = g.tip.at_end ? g.end_grown : g.start_grown;
+    EXPECT_NEAR(j_over_k(g.tip), 1, step <= 3 ? 0.10 : 0.05)
+        << (g.tip.at_end ? "end" : "start") << " tip, step " << step;
+  }
   const Vec2 centre(h / 2, 0);
   EXPECT_LT((plane.back() - centre + (plane.front() - centre)).norm(), c.fracture.growth_cells * h);
 
@@ -413,7 +438,7 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
   // re-solved from rest under the tension of that check (held, damped over
   // 12 transits). J/((K_I^2+K_II^2)/E') of the growth run less that of the
   // re-solve is what the motion left by the growth adds.
-  const int kStatic = std::getenv("HFMPM_TENSION_STATIC") ? std::atoi(std::getenv("HFMPM_TENSION_STATIC")) : 0;
+  const int kStatic = std::getenv("HFMPM_TENSION_STATIC") ? std::atoi(std::getenv("HFMPM_TENSION_STATIC")) : 3;
   for (const auto& g : log) {
     if (!g.tip.at_end || g.end_grown > kStatic) continue;
     SolidConfig rest = c;
@@ -431,6 +456,8 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
           "J/((K_I^2+K_II^2)/E') %.4f (growth run %.4f), K_I %.4e (growth run %.4e), K_II/K_I %+.4f (%+.4f)\n",
           g.end_grown, load, tip.j, g.tip.j, j_over_k(tip), j_over_k(g.tip), tip.k1, g.tip.k1, tip.k2 / tip.k1,
           g.tip.k2 / g.tip.k1);
+      EXPECT_NEAR(j_over_k(tip), 1, 0.07) << "re-solve of the end tip's check " << g.end_grown;
+      EXPECT_NEAR(g.tip.k1 / tip.k1, 1, 0.03) << "re-solve of the end tip's check " << g.end_grown;
     }
   }
 }
