@@ -412,7 +412,6 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
     if (b == at(n - 1)) continue;  // the last segment: on the x1 axis
     // Off the domain (q = 0 beyond sqrt(2) ro): nothing more.
     if (std::min((pa - f.position).norm(), (pb - f.position).norm()) - len > std::sqrt(2.0) * ro) continue;
-    sums.bend = std::max(sums.bend, std::atan2(std::abs(s_f.y()), s_f.x()));
     const Vec2 du_mean = 0.5 * (gradient_at(mid, 1, a, b) + gradient_at(mid, -1, a, b)) * s_f;  // d(mean u)/ds
     if (q > 0) {
       // Each face's field from its tangential gradient and its traction
@@ -473,7 +472,6 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
   tip.k1 = tip.modulus * (area.m1 + faces.m1) / 2;
   tip.k2 = tip.modulus * (area.m2 + faces.m2) / 2;
   tip.kink = max_hoop_stress_kink(tip.k1, tip.k2);
-  tip.bend = faces.bend;
   return tip;
 }
 
@@ -483,16 +481,9 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
 // interpenetration) has no mode-I singularity, but J, a quadratic, counts
 // it: in a confined body (in-situ stress 1e5 Pa, J_Ic 1e-3 J/m^2) the closed
 // dry tip ahead of a fluid-filled notch then grew although it was shut.
-// Where the crack bends by more than kBentCrack inside the J domain, G from
-// the interaction integral instead, (max(K_I, 0)^2 + K_II^2) / E': J's face
-// terms there multiply two discretized fields (the faces' tractions or
-// strains and their displacement gradients) near the kink's corner, where
-// the old tip's field is not resolved, while the interaction integral's
-// multiply the computed field by the exact auxiliary one (docs/solid.md).
 double growth_energy(const TipResult& tip, bool mode_one_only) {
   const double k1 = std::max(0.0, tip.k1), sum = tip.k1 * tip.k1 + tip.k2 * tip.k2;
   const double driving = k1 * k1 + (mode_one_only ? 0.0 : tip.k2 * tip.k2);
-  if (tip.bend > kBentCrack && tip.modulus > 0) return driving / tip.modulus;
   return sum > 0 ? tip.j * driving / sum : tip.j;
 }
 

@@ -37,7 +37,6 @@ struct TipResult {
   double j_faces = 0;              // J/m^2: the face-load part of j
   double k1 = 0, k2 = 0;           // Pa m^0.5, from the interaction integral (Williams auxiliary fields)
   double kink = 0;                 // rad, growth direction by maximum hoop stress, counter-clockwise from direction
-  double bend = 0;                 // rad, the largest angle between direction and a crack segment in J's domain
   double toughness = 0;            // J/m^2, J_Ic of the material at the tip
   double modulus = 0;              // Pa, plane-strain E' there
   std::size_t material = 0;        // index of the material at the tip
@@ -46,12 +45,8 @@ struct TipResult {
 // J/m^2: the energy release rate that drives growth, J without the share of
 // a negative K_I (a crack closed in compression): J (max(K_I, 0)^2 + K_II^2)
 // / (K_I^2 + K_II^2); with mode_one_only (straight growth by symmetry) the
-// K_II^2 term is left out of the numerator. Where the crack bends by more
-// than kBentCrack inside J's domain (a kink a few growth steps back), the
-// same from the interaction integral: (max(K_I, 0)^2 + K_II^2) / E'
-// (docs/solid.md: J's face terms near the kink's corner). A tip grows when it
-// reaches the toughness.
-inline constexpr double kBentCrack = 0.17453292519943295;  // rad, 10 degrees
+// K_II^2 term is left out of the numerator. A tip grows when it reaches the
+// toughness.
 double growth_energy(const TipResult& tip, bool mode_one_only = false);
 
 class Solver {
@@ -181,7 +176,6 @@ class Solver {
   };
   struct TipSums {
     double j = 0, m1 = 0, m2 = 0;  // J and the interaction integrals
-    double bend = 0;               // rad, face_work: the largest angle of a segment in the domain to x1
   };
   static TipFrame tip_frame(const Crack& crack, bool at_end);
   std::size_t material_at(const Vec2& x) const;
