@@ -70,6 +70,10 @@ class Crack {
   // Inserts a crack particle before the first (growth of a start tip; only
   // for cracks inside the body, which no fluid uses); it starts closed.
   void prepend(const Vec2& position);
+  // Moves the tip particle (the last one, or the first with at_end false) to
+  // `position` (growth that lengthens the tip segment instead of adding one);
+  // it stays closed.
+  void move_tip(bool at_end, const Vec2& position);
 
  private:
   std::uint32_t id_;
