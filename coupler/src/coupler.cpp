@@ -160,7 +160,25 @@ void Coupler::prepare() {
   manifest_.set("overrides", overrides);
   manifest_.set_number("protocol_version", proto::kProtocolVersion);
   prepared_ = true;
-  history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
+  if (options_.restart) {
+    // Continue the run's history after the checkpoint's row (the rows a killed
+    // run wrote after it go; the restart writes them again).
+    const auto& r = *options_.restart;
+    step_ = r.state.step();
+    t_ = r.state.t();
+    truncate_history(output_dir_ + "/history.csv", step_);
+    history_ = std::make_unique<History>(output_dir_ + "/history.csv", true);
+    manifest_.set("restarted_from", r.directory);
+    manifest_.set_number("restart_step", static_cast<double>(step_));
+    manifest_.set_number("restart_time_s", t_);
+    manifest_.set("restarted_run_id", r.state.run_id());
+    log_("restarting from " + r.directory + " (step " + std::to_string(step_) + ", t = " + std::to_string(t_) + " s)");
+  } else {
+    history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
+  }
+  if (scene_.output().checkpoint_interval_s() > 0) {
+    manifest_.set_number("checkpoint_interval_s", scene_.output().checkpoint_interval_s());
+  }
   {
     // The scene the run uses, every default filled in, as JSON: what a plot
     // or a script reads instead of repeating the scene's values.

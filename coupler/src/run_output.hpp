@@ -14,7 +14,8 @@ namespace hfmpm::coupling {
 
 class History {
  public:
-  explicit History(const std::string& path);
+  // append: continue an existing history (a restart; truncate_history first), without a new header.
+  explicit History(const std::string& path, bool append = false);
   void write(double t, std::uint64_t step, double dt, const SideDiagnostics& solid, const SideDiagnostics& fluid,
              double wall_s);
 

@@ -23,6 +23,7 @@ class File {
   // Datasets of the given dimensions (row-major); data may be null when a dimension is 0.
   void write_f64(const std::string& object, const std::vector<hsize_t>& dims, const double* data);
   void write_i32(const std::string& object, const std::vector<hsize_t>& dims, const std::int32_t* data);
+  void write_u64(const std::string& object, const std::vector<hsize_t>& dims, const std::uint64_t* data);
   // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
   void set_attribute(const std::string& object, const std::string& name, double value);
   void set_attribute(const std::string& object, const std::string& name, std::uint64_t value);
@@ -37,6 +38,29 @@ class File {
   void write_attribute(const std::string& object, const std::string& name, hid_t file_type, hid_t mem_type,
                        const void* data);
 
+  std::string path_;
+  hid_t id_ = -1;
+};
+
+// A file opened read-only (checkpoints): whole datasets and string attributes of the root group.
+class ReadFile {
+ public:
+  explicit ReadFile(const std::string& path);
+  ~ReadFile();
+  ReadFile(const ReadFile&) = delete;
+  ReadFile& operator=(const ReadFile&) = delete;
+
+  bool has(const std::string& object) const;
+  // The whole dataset, converted by HDF5 to the memory type; throws if it is missing.
+  std::vector<double> read_f64(const std::string& object) const;
+  std::vector<std::uint64_t> read_u64(const std::string& object) const;
+  // A string attribute of the root group; empty if there is none.
+  std::string root_attribute(const std::string& name) const;
+  const std::string& path() const { return path_; }
+
+ private:
+  void read(const std::string& object, hid_t mem_type, hid_t want_class, void* data, std::size_t n) const;
+  std::size_t elements(const std::string& object) const;
   std::string path_;
   hid_t id_ = -1;
 };

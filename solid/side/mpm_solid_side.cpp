@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 
+#include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/frame_writer.hpp"
 #include "hfmpm/proto/convert.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
@@ -44,10 +45,27 @@ class MpmSolidSide final : public coupling::SideModel {
                                 ? std::optional<TimeFunction>(proto::to_time_function(crack.pressure_pa()))
                                 : std::nullopt);
     }
-    if (scene.output().hdf5()) {
-      writer_.emplace(output_dir + "/solid.h5", "hfmpm solid: " + scene.name());
-      writer_->attribute("units", "SI; 2D quantities per unit thickness");
-    }
+    output_dir_ = output_dir;
+    title_ = "hfmpm solid: " + scene.name();
+    // Opened at the first frame: a restart names its own file first (load_checkpoint).
+    if (scene.output().hdf5()) frames_file_ = "solid.h5";
+  }
+  bool can_checkpoint() const override { return true; }
+  void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::write_checkpoint(path, stamp, [&](StateWriter& out) {
+      PrefixedWriter solver(out, "solid.");
+      solver_->save(solver);
+      out.put("side.published", published_);
+    });
+  }
+  void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::read_checkpoint(path, stamp, [&](const StateReader& in) {
+      PrefixedReader solver(in, "solid.");
+      solver_->load(solver);
+      in.get("side.published", published_);
+    });
+    // Frames after the checkpoint go to a file of their own: the frames up to it stay in solid.h5.
+    if (!frames_file_.empty()) frames_file_ = "solid-restart-" + std::to_string(stamp.step) + ".h5";
   }
   double stable_dt() const override { return solver_->stable_dt(); }
   std::string stable_dt_limit() const override {
@@ -114,7 +132,7 @@ class MpmSolidSide final : public coupling::SideModel {
     return d;
   }
   void write_output(std::uint64_t /*frame*/, double t) override {
-    if (!writer_) return;
+    if (!open_writer()) return;
     const auto& p = solver_->particles();
     writer_->begin_frame(t, solver_->steps());
     writer_->points("particles", p.x);
@@ -182,7 +200,17 @@ class MpmSolidSide final : public coupling::SideModel {
     return g;
   }
 
+  // The frame file, created at the first frame.
+  bool open_writer() {
+    if (!writer_ && !frames_file_.empty()) {
+      writer_.emplace(output_dir_ + "/" + frames_file_, title_);
+      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+    }
+    return writer_.has_value();
+  }
+
   std::optional<mpm::Solver> solver_;
+  std::string output_dir_, title_, frames_file_;  // frames_file_: empty without output.hdf5
   std::vector<std::optional<TimeFunction>> prescribed_;
   bool implicit_ = false;               // coupling.scheme IMPLICIT: publish the faces' response
   std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)

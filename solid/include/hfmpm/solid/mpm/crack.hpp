@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hfmpm/exchange.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::solid::mpm {
 
@@ -70,6 +71,11 @@ class Crack {
   // Inserts a crack particle before the first (growth of a start tip; only
   // for cracks inside the body, which no fluid uses); it starts closed.
   void prepend(const Vec2& position);
+
+  // Checkpoints: every member but the id and the tip flags (which the scene fixes); load()
+  // restores this crack bit for bit (solid/src/mpm/checkpoint.cpp).
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
 
  private:
   std::uint32_t id_;
