@@ -31,7 +31,7 @@ class MpmFluidSide final : public coupling::SideModel {
     max_substeps_ = std::max<std::uint32_t>(1, f.max_substeps());
     output_dir_ = output_dir;
     title_ = "hfmpm fluid: " + scene.name();
-    // Opened at the first frame: a restart names its own file first (load_checkpoint).
+    // Opened at the first frame, or continued by a restart (load_checkpoint).
     if (scene.output().hdf5()) frames_file_ = "fluid.h5";
   }
 
@@ -48,6 +48,7 @@ class MpmFluidSide final : public coupling::SideModel {
       out.put("side.received", static_cast<int>(received_));
       out.put("side.substeps", substeps_);
       out.put("side.steps", steps_);
+      save_frames(out);
     });
   }
   void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
@@ -65,9 +66,8 @@ class MpmFluidSide final : public coupling::SideModel {
       received_ = received != 0;
       in.get("side.substeps", substeps_);
       in.get("side.steps", steps_);
+      resume_frames(in);
     });
-    // Frames after the checkpoint go to a file of their own: the frames up to it stay in fluid.h5.
-    if (!frames_file_.empty()) frames_file_ = "fluid-restart-" + std::to_string(stamp.step) + ".h5";
   }
 
   // The coupled step may hold max_substeps fluid steps (the fluid subcycles).
@@ -213,6 +213,21 @@ class MpmFluidSide final : public coupling::SideModel {
   }
   std::uint64_t steps_of_first() const { return cracks_.empty() ? 0 : cracks_.front().solver.steps(); }
 
+  // The frame file's state goes into a checkpoint; a restart continues the
+  // file from it (frames a killed run wrote after the checkpoint go).
+  void save_frames(StateWriter& out) const {
+    out.put("side.frames", writer_ ? 1 : 0);
+    if (!writer_) return;
+    PrefixedWriter frames(out, "frames.");
+    writer_->save(frames);
+  }
+  void resume_frames(const StateReader& in) {
+    int frames = 0;
+    in.get("side.frames", frames);
+    if (frames == 0 || frames_file_.empty()) return;
+    writer_.reset();
+    writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
+  }
   // The frame file, created at the first frame.
   bool open_writer() {
     if (!writer_ && !frames_file_.empty()) {

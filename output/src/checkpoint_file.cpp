@@ -36,6 +36,10 @@ class H5StateWriter final : public StateWriter {
     check(name);
     file_.write_u64(name, {values.size()}, values.data());
   }
+  void text(const std::string& name, const std::string& bytes) override {
+    check(name);
+    file_.write_u8(name, {bytes.size()}, reinterpret_cast<const std::uint8_t*>(bytes.data()));
+  }
 
  private:
   void check(const std::string& name) {
@@ -51,6 +55,7 @@ class H5StateReader final : public StateReader {
   explicit H5StateReader(const h5::ReadFile& file) : file_(file) {}
   std::vector<double> f64(const std::string& name) const override { return file_.read_f64(name); }
   std::vector<std::uint64_t> u64(const std::string& name) const override { return file_.read_u64(name); }
+  std::string text(const std::string& name) const override { return file_.read_text(name); }
 
  private:
   const h5::ReadFile& file_;

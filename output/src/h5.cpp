@@ -84,6 +84,45 @@ File::File(const std::string& path) : path_(path) {
   if (!access.close()) fail(path_, "closing the file-access property list of", "");
 }
 
+File::File(const std::string& path, OpenExisting) : path_(path) {
+  Quiet quiet;
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!access.valid()) fail(path_, "creating a file-access property list for", "");
+#if (H5_VERSION_GE(1, 10, 7) && !H5_VERSION_GE(1, 12, 0)) || H5_VERSION_GE(1, 12, 1)
+  if (H5Pset_file_locking(access.get(), false, true) < 0) fail(path_, "disabling file locking for", "");
+#endif
+  id_ = H5Fopen(path_.c_str(), H5F_ACC_RDWR, access.get());
+  if (id_ < 0) fail(path_, "opening for writing (H5Fopen)", "");
+  if (!access.close()) fail(path_, "closing the file-access property list of", "");
+}
+
+namespace {
+herr_t collect_name(hid_t /*group*/, const char* name, const H5L_info_t* /*info*/, void* data) {
+  static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+  return 0;
+}
+}  // namespace
+
+std::vector<std::string> File::children(const std::string& group) {
+  Quiet quiet;
+  std::vector<std::string> names;
+  Handle g(H5Gopen2(id_, group.c_str(), default_plist()), H5Gclose);
+  if (!g.valid()) fail(path_, "opening group", group);
+  if (H5Literate(g.get(), H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_name, &names) < 0) {
+    fail(path_, "listing group", group);
+  }
+  return names;
+}
+
+void File::remove(const std::string& object) {
+  Quiet quiet;
+  if (H5Ldelete(id_, object.c_str(), default_plist()) < 0) fail(path_, "removing", object);
+}
+
+void File::write_u8(const std::string& object, const std::vector<hsize_t>& dims, const std::uint8_t* data) {
+  write_dataset(object, dims, H5T_STD_U8LE, H5T_NATIVE_UINT8, data);
+}
+
 File::~File() {
   if (id_ >= 0) {
     Quiet quiet;
@@ -237,6 +276,12 @@ std::vector<std::uint64_t> ReadFile::read_u64(const std::string& object) const {
   std::vector<std::uint64_t> values(elements(object));
   read(object, H5T_NATIVE_UINT64, H5T_INTEGER, values.data(), values.size());
   return values;
+}
+
+std::string ReadFile::read_text(const std::string& object) const {
+  std::string bytes(elements(object), '\0');
+  read(object, H5T_NATIVE_UINT8, H5T_INTEGER, bytes.data(), bytes.size());
+  return bytes;
 }
 
 std::string ReadFile::root_attribute(const std::string& name) const {

@@ -15,6 +15,9 @@ class File {
  public:
   // Creates the file, truncating an existing one.
   explicit File(const std::string& path);
+  // Opens an existing file for writing (FrameWriter's resume after a restart).
+  struct OpenExisting {};
+  File(const std::string& path, OpenExisting);
   ~File();
   File(const File&) = delete;
   File& operator=(const File&) = delete;
@@ -24,7 +27,10 @@ class File {
   void write_f64(const std::string& object, const std::vector<hsize_t>& dims, const double* data);
   void write_i32(const std::string& object, const std::vector<hsize_t>& dims, const std::int32_t* data);
   void write_u64(const std::string& object, const std::vector<hsize_t>& dims, const std::uint64_t* data);
-  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
+  void write_u8(const std::string& object, const std::vector<hsize_t>& dims, const std::uint8_t* data);
+  // Names of the links in a group, and removing one (with what hangs below it).
+  std::vector<std::string> children(const std::string& group);
+  void remove(const std::string& object);  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
   void set_attribute(const std::string& object, const std::string& name, double value);
   void set_attribute(const std::string& object, const std::string& name, std::uint64_t value);
   void set_attribute(const std::string& object, const std::string& name, const std::string& value);
@@ -54,6 +60,7 @@ class ReadFile {
   // The whole dataset, converted by HDF5 to the memory type; throws if it is missing.
   std::vector<double> read_f64(const std::string& object) const;
   std::vector<std::uint64_t> read_u64(const std::string& object) const;
+  std::string read_text(const std::string& object) const;  // a uint8 dataset as bytes
   // A string attribute of the root group; empty if there is none.
   std::string root_attribute(const std::string& name) const;
   const std::string& path() const { return path_; }

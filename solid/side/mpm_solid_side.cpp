@@ -47,7 +47,7 @@ class MpmSolidSide final : public coupling::SideModel {
     }
     output_dir_ = output_dir;
     title_ = "hfmpm solid: " + scene.name();
-    // Opened at the first frame: a restart names its own file first (load_checkpoint).
+    // Opened at the first frame, or continued by a restart (load_checkpoint).
     if (scene.output().hdf5()) frames_file_ = "solid.h5";
   }
   bool can_checkpoint() const override { return true; }
@@ -56,6 +56,7 @@ class MpmSolidSide final : public coupling::SideModel {
       PrefixedWriter solver(out, "solid.");
       solver_->save(solver);
       out.put("side.published", published_);
+      save_frames(out);
     });
   }
   void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
@@ -63,9 +64,8 @@ class MpmSolidSide final : public coupling::SideModel {
       PrefixedReader solver(in, "solid.");
       solver_->load(solver);
       in.get("side.published", published_);
+      resume_frames(in);
     });
-    // Frames after the checkpoint go to a file of their own: the frames up to it stay in solid.h5.
-    if (!frames_file_.empty()) frames_file_ = "solid-restart-" + std::to_string(stamp.step) + ".h5";
   }
   double stable_dt() const override { return solver_->stable_dt(); }
   std::string stable_dt_limit() const override {
@@ -200,6 +200,21 @@ class MpmSolidSide final : public coupling::SideModel {
     return g;
   }
 
+  // The frame file's state goes into a checkpoint; a restart continues the
+  // file from it (frames a killed run wrote after the checkpoint go).
+  void save_frames(StateWriter& out) const {
+    out.put("side.frames", writer_ ? 1 : 0);
+    if (!writer_) return;
+    PrefixedWriter frames(out, "frames.");
+    writer_->save(frames);
+  }
+  void resume_frames(const StateReader& in) {
+    int frames = 0;
+    in.get("side.frames", frames);
+    if (frames == 0 || frames_file_.empty()) return;
+    writer_.reset();
+    writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
+  }
   // The frame file, created at the first frame.
   bool open_writer() {
     if (!writer_ && !frames_file_.empty()) {

@@ -32,6 +32,7 @@ class StateWriter {
   // One named array; a name is written once per archive ([A-Za-z0-9_.]+).
   virtual void f64(const std::string& name, const std::vector<double>& values) = 0;
   virtual void u64(const std::string& name, const std::vector<std::uint64_t>& values) = 0;
+  virtual void text(const std::string& name, const std::string& bytes) = 0;
 
   void put(const std::string& name, double value) { f64(name, {value}); }
   void put(const std::string& name, const std::vector<double>& values) { f64(name, values); }
@@ -64,6 +65,7 @@ class StateReader {
   // The named array; throws std::runtime_error naming it if it is missing or of another type.
   virtual std::vector<double> f64(const std::string& name) const = 0;
   virtual std::vector<std::uint64_t> u64(const std::string& name) const = 0;
+  virtual std::string text(const std::string& name) const = 0;
 
   void get(const std::string& name, double& value) const { value = one(f64(name), name); }
   void get(const std::string& name, std::vector<double>& values) const { values = f64(name); }
@@ -111,6 +113,7 @@ class PrefixedWriter final : public StateWriter {
   PrefixedWriter(StateWriter& inner, std::string prefix) : inner_(inner), prefix_(std::move(prefix)) {}
   void f64(const std::string& name, const std::vector<double>& v) override { inner_.f64(prefix_ + name, v); }
   void u64(const std::string& name, const std::vector<std::uint64_t>& v) override { inner_.u64(prefix_ + name, v); }
+  void text(const std::string& name, const std::string& bytes) override { inner_.text(prefix_ + name, bytes); }
 
  private:
   StateWriter& inner_;
@@ -122,6 +125,7 @@ class PrefixedReader final : public StateReader {
   PrefixedReader(const StateReader& inner, std::string prefix) : inner_(inner), prefix_(std::move(prefix)) {}
   std::vector<double> f64(const std::string& name) const override { return inner_.f64(prefix_ + name); }
   std::vector<std::uint64_t> u64(const std::string& name) const override { return inner_.u64(prefix_ + name); }
+  std::string text(const std::string& name) const override { return inner_.text(prefix_ + name); }
 
  private:
   const StateReader& inner_;
