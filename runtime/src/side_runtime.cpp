@@ -167,10 +167,10 @@ class SideRuntime {
       // The state after the checkpoint's step, with what each side last
       // received from the other: no step-0 exchange.
       const auto& r = welcome_.restart();
-      model_.load_checkpoint(checkpoint_path(r.directory()), stamp(r.step(), r.t()));
       step_ = r.step();
       t_ = r.t();
       heartbeat_step_ = step_;
+      model_.load_checkpoint(checkpoint_path(r.directory()), stamp(r.step(), r.t()));
     }
     if (scene.output().exchange_log()) log_ = std::make_unique<ExchangeLog>(output_dir, role_);
 
