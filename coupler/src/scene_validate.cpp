@@ -89,7 +89,9 @@ void check_time(Checker& c, const scene::Scene& s) {
           "s, 0 for no checkpoints");
   if (s.output().checkpoint_interval_s() > 0 &&
       ((s.has_solid() && s.solid().has_prescribed_crack()) || (s.has_fluid() && s.fluid().has_prescribed_pressure()))) {
-    c.bad("output.checkpoint_interval_s", std::to_string(s.output().checkpoint_interval_s()),
+    std::ostringstream value;
+    value << s.output().checkpoint_interval_s();
+    c.bad("output.checkpoint_interval_s", value.str(),
           "0 with a stand-in side (solid.prescribed_crack, fluid.prescribed_pressure): the stand-ins do not write "
           "checkpoints; only the MPM sides do");
   }
