@@ -150,7 +150,9 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     if (command != "run") throw UsageError("--restart is for 'hfmpm run'");
     if (!out.empty()) throw UsageError("--restart DIR continues in DIR; --out is not allowed with it");
     if (scene_path.empty() && !overrides.empty()) {
-      throw UsageError("--set needs the scene file: hfmpm run --restart DIR SCENE --set ... (the same as the run's)");
+      throw UsageError(
+          "--set and --transport need the scene file: hfmpm run --restart DIR SCENE --set ... (the run's own scene "
+          "and overrides; without SCENE the checkpoint's scene is used as it is)");
     }
     try {
       restart_point = std::make_shared<coupling::RestartPoint>(coupling::find_restart(restart));

@@ -143,7 +143,7 @@ void Coupler::report_rest() {
 void Coupler::prepare() {
   fs::create_directories(options_.output_dir);
   output_dir_ = fs::absolute(options_.output_dir).string();
-  log_.open(output_dir_ + "/coupler.log", options_.progress);
+  log_.open(output_dir_ + "/coupler.log", options_.progress, options_.restart != nullptr);
   manifest_ = Manifest(output_dir_ + "/run.json");
   run_id_ = random_id();
   manifest_.set("run_id", run_id_);
@@ -353,7 +353,7 @@ void Coupler::launch_sides() {
     side.log_path = output_dir_ + "/" + side.name + ".log";
     const std::string program = program_for(side);
     try {
-      side.process = std::make_unique<ChildProcess>(program, args, side.log_path);
+      side.process = std::make_unique<ChildProcess>(program, args, side.log_path, options_.restart != nullptr);
     } catch (const std::exception& e) {
       throw RunFailure{"cannot start the " + side.name + " side: " + e.what()};
     }

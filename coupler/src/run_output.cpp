@@ -69,7 +69,9 @@ void Manifest::save() const {
   std::rename(tmp.c_str(), path_.c_str());
 }
 
-void Log::open(const std::string& path) { file_.open(path, std::ios::trunc); }
+void Log::open_file(const std::string& path, bool append) {
+  file_.open(path, std::ios::out | (append ? std::ios::app : std::ios::trunc));
+}
 
 void Log::operator()(const std::string& line) {
   if (echo_) std::cerr << "hfmpm: " << line << "\n";

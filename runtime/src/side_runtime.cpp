@@ -172,7 +172,10 @@ class SideRuntime {
       heartbeat_step_ = step_;
       model_.load_checkpoint(checkpoint_path(r.directory()), stamp(r.step(), r.t()));
     }
-    if (scene.output().exchange_log()) log_ = std::make_unique<ExchangeLog>(output_dir, role_);
+    if (scene.output().exchange_log()) {
+      log_ = std::make_unique<ExchangeLog>(output_dir, role_,
+                                           restart ? static_cast<std::int64_t>(welcome_.restart().step()) : -1);
+    }
 
     heartbeat_->set_interval(scene.coupling().heartbeat_interval_s());
     last_from_coupler_ = Clock::now();

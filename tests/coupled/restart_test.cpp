@@ -139,13 +139,19 @@ TEST(Restart, AfterKillNineEqualsTheUninterruptedRun) {
 
   // history.csv: the same rows (none twice, none missing) and values, but the wall clock.
   expect_same_history(read_csv(a + "/history.csv"), read_csv(b + "/history.csv"));
-  // The data that crossed the data plane after the checkpoint, 17 digits.
+  // The data that crossed the data plane, 17 digits: after the checkpoint, and the whole log
+  // (the restart keeps the rows up to the checkpoint and drops the killed run's later ones).
   for (const std::string role : {"solid", "fluid"}) {
     const auto x = exchange_rows_after(a + "/" + role + "_received.csv", checkpoint);
     const auto y = exchange_rows_after(b + "/" + role + "_received.csv", checkpoint);
     EXPECT_GT(x.size(), 100u);
     EXPECT_EQ(x, y) << role << "_received.csv after step " << checkpoint;
+    EXPECT_EQ(read_file(a + "/" + role + "_received.csv"), read_file(b + "/" + role + "_received.csv")) << role;
   }
+  // The logs go on: the first run's lines are kept.
+  const std::string log = read_file(b + "/coupler.log");
+  EXPECT_NE(log.find("checkpoint checkpoints/step-"), std::string::npos) << log;
+  EXPECT_NE(log.find("restarting from checkpoints/step-"), std::string::npos) << log;
   // The side's frame files: every frame, bit for bit (the killed run's frames past the checkpoint were dropped).
   std::size_t datasets = 0;
   expect_same_frames(a + "/solid.h5", b + "/solid.h5", datasets);
@@ -155,6 +161,47 @@ TEST(Restart, AfterKillNineEqualsTheUninterruptedRun) {
   EXPECT_EQ(json_string(manifest, "status"), "completed");
   EXPECT_EQ(json_number(manifest, "restart_step"), static_cast<double>(checkpoint));
   EXPECT_NE(json_string(manifest, "restarted_from").find("checkpoints/step-"), std::string::npos);
+}
+
+// The other schemes: IMPLICIT (a block ends with the solid's next step begun, its grid
+// mid-step) on kgd-paper-field-ci, and Jacobi with an exchange every second step. The run's
+// directory is copied, its last checkpoint removed, and the copy continued from the one
+// before: it must end as the original did.
+void expect_continued_run_equal(const std::vector<std::string>& run_argv, const std::string& dir) {
+  const std::string a = dir + "/a", b = dir + "/b";
+  std::vector<std::string> argv = run_argv;
+  argv.insert(argv.end(), {"--out", a, "--quiet"});
+  const auto whole = run(argv, 120);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const auto steps = complete_checkpoints(a);
+  ASSERT_EQ(steps.size(), 2u);
+  fs::copy(a, b, fs::copy_options::recursive);
+  std::ostringstream last;
+  last << b << "/checkpoints/step-" << std::setw(12) << std::setfill('0') << steps.back();
+  fs::remove_all(last.str());
+  const auto restarted = run({bin("hfmpm"), "run", "--restart", b, "--quiet"}, 120);
+  ASSERT_EQ(restarted.exit_code, 0) << restarted.err;
+  EXPECT_EQ(json_number(read_file(b + "/run.json"), "restart_step"), static_cast<double>(steps.front()));
+  expect_same_history(read_csv(a + "/history.csv"), read_csv(b + "/history.csv"));
+  std::size_t datasets = 0;
+  expect_same_frames(a + "/solid.h5", b + "/solid.h5", datasets);
+  expect_same_frames(a + "/fluid.h5", b + "/fluid.h5", datasets);
+  for (const std::string role : {"solid", "fluid"}) {
+    EXPECT_EQ(read_file(a + "/" + role + "_received.csv"), read_file(b + "/" + role + "_received.csv")) << role;
+  }
+}
+
+TEST(Restart, ImplicitAndJacobiSchemesContinueBitForBit) {
+  const auto dir = scratch_dir("restart-schemes");
+  expect_continued_run_equal({bin("hfmpm"), "run", source("scenarios/kgd-paper-field-ci.scene"), "--set",
+                              "time.end_s=30", "--set", "output.interval_s=2", "--set",
+                              "output.checkpoint_interval_s=10", "--set", "output.exchange_log=true"},
+                             dir + "/implicit");
+  expect_continued_run_equal({bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"), "--set",
+                              "time.end_s=0.2", "--set", "output.interval_s=0.05", "--set",
+                              "output.checkpoint_interval_s=0.06", "--set", "output.exchange_log=true", "--set",
+                              "coupling.scheme=JACOBI", "--set", "coupling.exchange_interval=2"},
+                             dir + "/jacobi");
 }
 
 TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {
