@@ -118,8 +118,7 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     else if (arg == "--restart") {
       restart = value();
       if (restart.empty()) throw UsageError("--restart needs the run directory to continue");
-    }
-    else if (arg == "--bind")
+    } else if (arg == "--bind")
       bind = value();
     else if (arg == "--quiet")
       options.progress = false;

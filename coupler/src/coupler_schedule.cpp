@@ -215,7 +215,9 @@ void Coupler::step_loop(RunSummary& summary) {
     history.write(t_, step_, schedule.dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
     if (energy_) energy_->start(sides_[1].diagnostics);
     schedule.next_output = interval;
-    schedule.next_checkpoint = checkpoint_interval > 0 ? checkpoint_interval : kInf;
+    schedule.next_checkpoint = checkpoint_interval > 0
+                                   ? checkpoint_interval
+                                   : kInf;  // NOLINT(bugprone-narrowing-conversions): clang-tidy 14 misreads inf
   }
   double& dt = schedule.dt;
   std::uint64_t& frame = schedule.frame;
@@ -254,8 +256,8 @@ void Coupler::step_loop(RunSummary& summary) {
     command->set_output_frame(output ? frame : 0);
     // A checkpoint at the first output row at or after each multiple of the
     // interval (not at the end: nothing would continue from it).
-    const bool checkpoint = output && t_end >= schedule.next_checkpoint * (1 - 1e-12) && t_end < end * (1 - 1e-12) &&
-                            !last_allowed;
+    const bool checkpoint =
+        output && t_end >= schedule.next_checkpoint * (1 - 1e-12) && t_end < end * (1 - 1e-12) && !last_allowed;
     const std::string checkpoint_dir = checkpoint ? checkpoint_directory(step_ + n) : std::string();
     command->set_checkpoint(checkpoint);
     command->set_checkpoint_directory(checkpoint_dir);
@@ -305,8 +307,7 @@ void Coupler::step_loop(RunSummary& summary) {
     if (checkpoint) {
       for (const auto& side : sides_) {
         if (side.expected && !side.report->checkpoint_written()) {
-          throw RunFailure{"the " + side.name + " side did not write the checkpoint" + at_step() +
-                           " it was asked for"};
+          throw RunFailure{"the " + side.name + " side did not write the checkpoint" + at_step() + " it was asked for"};
         }
       }
       while (schedule.next_checkpoint <= t_ * (1 + 1e-12)) schedule.next_checkpoint += checkpoint_interval;
@@ -401,8 +402,8 @@ void Coupler::restore_checkpoint(Schedule& schedule, RunSummary& summary) {
     side.exchange_s = in.exchange_s();
   }
   if (energy_) {
-    energy_->restore({s.energy_e0(), s.energy_p(), s.energy_v(), s.energy_work(), s.energy_largest(),
-                      s.energy_largest_t()});
+    energy_->restore(
+        {s.energy_e0(), s.energy_p(), s.energy_v(), s.energy_work(), s.energy_largest(), s.energy_largest_t()});
   }
   if (rest_) rest_->restore({s.rest_kinetic(), s.rest_strain(), s.rest_reports()});
   max_coupling_lag_ = s.max_coupling_lag();

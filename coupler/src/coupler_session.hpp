@@ -197,7 +197,8 @@ class Coupler {
   Clock::time_point start_ = Clock::now(), last_housekeeping_{};
   Clock::duration stalled_{};
   Clock::time_point stepping_start_ = Clock::now();  // the step loop's start
-  double stepping_before_ = 0;                       // s of stepping before a restart's checkpoint  // time the coupler itself did not run (housekeeping())
+  double stepping_before_ =
+      0;  // s of stepping before a restart's checkpoint  // time the coupler itself did not run (housekeeping())
   std::uint64_t step_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
   std::unique_ptr<EnergyWatch> energy_;

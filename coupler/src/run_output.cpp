@@ -11,7 +11,8 @@
 
 namespace hfmpm::coupling {
 
-History::History(const std::string& path, bool append) : out_(path, std::ios::out | (append ? std::ios::app : std::ios::trunc)) {
+History::History(const std::string& path, bool append)
+    : out_(path, std::ios::out | (append ? std::ios::app : std::ios::trunc)) {
   if (!out_) throw std::runtime_error("cannot write " + path);
   out_ << std::setprecision(10);
   if (append) return;

@@ -121,14 +121,14 @@ void read_checkpoint(const std::string& path, const CheckpointStamp& expected,
     const std::string found = file.root_attribute(key);
     if (found != value) {
       std::string what = key;
-      if (key == "t_bits") what = "t (as bits; " + file.root_attribute("t_s") + " s against " + text(expected.t) + " s)";
-      throw std::runtime_error("checkpoint " + path + " has " + what + " = '" + found + "', this run needs '" + value +
-                               "'" +
-                               (key == "scene_hash" ? ": it was written for another scene" :
-                                key == "program_version" || key == "protocol_version" ||
-                                        key == "scene_schema_version" || key == "format"
-                                    ? ": it was written by another version of the program"
-                                    : ""));
+      if (key == "t_bits")
+        what = "t (as bits; " + file.root_attribute("t_s") + " s against " + text(expected.t) + " s)";
+      throw std::runtime_error(
+          "checkpoint " + path + " has " + what + " = '" + found + "', this run needs '" + value + "'" +
+          (key == "scene_hash" ? ": it was written for another scene"
+           : key == "program_version" || key == "protocol_version" || key == "scene_schema_version" || key == "format"
+               ? ": it was written by another version of the program"
+               : ""));
     }
   }
   H5StateReader reader(file);

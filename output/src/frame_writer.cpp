@@ -231,7 +231,8 @@ FrameWriter::FrameWriter(const std::string& h5_path, const StateReader& saved) {
   saved.get("last_time", last);
   if (has_last) m.last_time = last;
   const auto information = saved_strings(saved, "information");
-  for (std::size_t i = 0; i + 1 < information.size(); i += 2) m.information.emplace_back(information[i], information[i + 1]);
+  for (std::size_t i = 0; i + 1 < information.size(); i += 2)
+    m.information.emplace_back(information[i], information[i + 1]);
   const auto sets = saved_strings(saved, "sets");
   for (std::size_t i = 0; i < sets.size(); ++i) {
     m.collections.push_back(xdmf::Collection{sets[i], saved_strings(saved, "grids" + std::to_string(i))});

@@ -30,7 +30,8 @@ class File {
   void write_u8(const std::string& object, const std::vector<hsize_t>& dims, const std::uint8_t* data);
   // Names of the links in a group, and removing one (with what hangs below it).
   std::vector<std::string> children(const std::string& group);
-  void remove(const std::string& object);  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
+  void remove(const std::string&
+                  object);  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
   void set_attribute(const std::string& object, const std::string& name, double value);
   void set_attribute(const std::string& object, const std::string& name, std::uint64_t value);
   void set_attribute(const std::string& object, const std::string& name, const std::string& value);

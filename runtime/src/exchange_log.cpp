@@ -1,8 +1,8 @@
 #include "exchange_log.hpp"
 
 #include <iomanip>
-#include <string>
 #include <stdexcept>
+#include <string>
 
 namespace hfmpm::coupling {
 

@@ -213,8 +213,8 @@ class SideRuntime {
         data_ = transport_->connect_data(welcome_.data_plane().endpoint(), limit, curve);
       }
       // Initial exchange (step 0), in the scheme's order; none on a restart.
-      for (const auto& action : restart ? std::vector<CouplingScheme::Action>{}
-                                        : scheme_->initial_exchange(options_.role)) {
+      for (const auto& action :
+           restart ? std::vector<CouplingScheme::Action>{} : scheme_->initial_exchange(options_.role)) {
         if (action.kind == CouplingScheme::Action::Publish) {
           publish();
         } else {
@@ -332,8 +332,14 @@ class SideRuntime {
     if (command.write_output()) model_.write_output(command.output_frame(), t_);
     if (command.checkpoint()) {
       const auto start = Clock::now();
-      model_.save_checkpoint(checkpoint_path(command.checkpoint_directory()), stamp(step_, t_));
-      compute_s += seconds_since(start);
+      const std::string path = checkpoint_path(command.checkpoint_directory());
+      model_.save_checkpoint(path, stamp(step_, t_));
+      const double took = seconds_since(start);
+      compute_s += took;
+      std::error_code size_error;
+      const auto bytes = std::filesystem::file_size(path, size_error);
+      std::cerr << role_ << ": checkpoint " << path << " written in " << took << " s ("
+                << (size_error ? 0.0 : static_cast<double>(bytes) / 1e6) << " MB)\n";
     }
 
     protocol::Envelope envelope;

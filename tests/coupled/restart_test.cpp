@@ -27,14 +27,13 @@ namespace fs = std::filesystem;
 // kgd-viscosity-ci to 0.4 s: frames every 0.05 s, checkpoints at 0.15 and 0.3
 // s (about 700 coupled steps of the MPM solid and fluid, 3 s on 2 cores), the
 // data crossing the data plane logged with 17 digits.
-const std::vector<std::string> kSets{"--set", "time.end_s=0.4",
-                                     "--set", "output.interval_s=0.05",
-                                     "--set", "output.checkpoint_interval_s=0.15",
-                                     "--set", "output.exchange_log=true"};
+const std::vector<std::string> kSets{
+    "--set", "time.end_s=0.4",          "--set", "output.interval_s=0.05", "--set", "output.checkpoint_interval_s=0.15",
+    "--set", "output.exchange_log=true"};
 
 std::vector<std::string> run_args(const std::string& out) {
-  std::vector<std::string> argv{bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"), "--out", out,
-                                "--quiet"};
+  std::vector<std::string> argv{bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"),
+                                "--out",      out,   "--quiet"};
   argv.insert(argv.end(), kSets.begin(), kSets.end());
   return argv;
 }
@@ -44,7 +43,8 @@ std::vector<std::uint64_t> complete_checkpoints(const std::string& out) {
   std::vector<std::uint64_t> steps;
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(out + "/checkpoints", error)) {
-    if (fs::exists(entry.path() / "coupler.pb")) steps.push_back(std::stoull(entry.path().filename().string().substr(5)));
+    if (fs::exists(entry.path() / "coupler.pb"))
+      steps.push_back(std::stoull(entry.path().filename().string().substr(5)));
   }
   std::sort(steps.begin(), steps.end());
   return steps;
@@ -193,15 +193,15 @@ void expect_continued_run_equal(const std::vector<std::string>& run_argv, const 
 
 TEST(Restart, ImplicitAndJacobiSchemesContinueBitForBit) {
   const auto dir = scratch_dir("restart-schemes");
-  expect_continued_run_equal({bin("hfmpm"), "run", source("scenarios/kgd-paper-field-ci.scene"), "--set",
-                              "time.end_s=30", "--set", "output.interval_s=2", "--set",
-                              "output.checkpoint_interval_s=10", "--set", "output.exchange_log=true"},
-                             dir + "/implicit");
-  expect_continued_run_equal({bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"), "--set",
-                              "time.end_s=0.2", "--set", "output.interval_s=0.05", "--set",
-                              "output.checkpoint_interval_s=0.06", "--set", "output.exchange_log=true", "--set",
-                              "coupling.scheme=JACOBI", "--set", "coupling.exchange_interval=2"},
-                             dir + "/jacobi");
+  expect_continued_run_equal(
+      {bin("hfmpm"), "run", source("scenarios/kgd-paper-field-ci.scene"), "--set", "time.end_s=30", "--set",
+       "output.interval_s=2", "--set", "output.checkpoint_interval_s=10", "--set", "output.exchange_log=true"},
+      dir + "/implicit");
+  expect_continued_run_equal(
+      {bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"), "--set", "time.end_s=0.2", "--set",
+       "output.interval_s=0.05", "--set", "output.checkpoint_interval_s=0.06", "--set", "output.exchange_log=true",
+       "--set", "coupling.scheme=JACOBI", "--set", "coupling.exchange_interval=2"},
+      dir + "/jacobi");
 }
 
 TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {

@@ -173,7 +173,7 @@ int restart_command(int trials, const CommonOptions& options) {
   static const std::vector<std::string> transports{"ipc", "tcp", "inproc"};
   for (int i = 0; i < trials; ++i) {
     Rng rng(options.seed, 4, static_cast<std::uint64_t>(i));
-    const std::string transport = transports[static_cast<std::size_t>(i) % transports.size()];
+    const std::string& transport = transports[static_cast<std::size_t>(i) % transports.size()];
     const std::string victim =
         transport == "inproc" ? "coupler" : rng.pick(std::vector<std::string>{"coupler", "coupler", "solid", "fluid"});
     const double delay = rng.uniform(0.0, 0.9 * whole_s);
@@ -192,8 +192,8 @@ int restart_command(int trials, const CommonOptions& options) {
       equal += o.equal;
       failed += !o.equal;
       if (o.restarted) restart_times.push_back(o.restart_s);
-      std::cout << "restarted from step " << o.restart_step << " in " << fixed(o.restart_s, 2) << " s: "
-                << (o.equal ? "equal to the uninterrupted run" : "DIFFERENT");
+      std::cout << "restarted from step " << o.restart_step << " in " << fixed(o.restart_s, 2)
+                << " s: " << (o.equal ? "equal to the uninterrupted run" : "DIFFERENT");
     } else {
       refused_ok += o.refused_ok;
       failed += !o.refused_ok;
@@ -210,8 +210,8 @@ int restart_command(int trials, const CommonOptions& options) {
             << " of " << with_checkpoint << "\n"
             << "  killed before the first checkpoint, restart refused naming it: " << refused_ok << " of "
             << killed - with_checkpoint << "\n"
-            << "  restart wall time: median " << fixed(median(restart_times), 2) << " s (the uninterrupted run: "
-            << fixed(whole_s, 2) << " s)\n";
+            << "  restart wall time: median " << fixed(median(restart_times), 2)
+            << " s (the uninterrupted run: " << fixed(whole_s, 2) << " s)\n";
   return conclude(failed == 0 && killed > 0, root, options);
 }
 

@@ -152,12 +152,14 @@ void FluidSolver::load(const StateReader& in) {
   in.get("pieces.count", piece_count);
   in.get("pieces.element", piece_element);
   in.get("pieces.fraction", piece_fraction);
-  if (piece_element.size() != piece_fraction.size()) throw std::runtime_error("checkpoint: fluid pieces differ in size");
+  if (piece_element.size() != piece_fraction.size())
+    throw std::runtime_error("checkpoint: fluid pieces differ in size");
   pieces_.assign(piece_count.size(), {});
   std::size_t at = 0;
   for (std::size_t p = 0; p < piece_count.size(); ++p) {
     if (at + piece_count[p] > piece_element.size()) throw std::runtime_error("checkpoint: fluid pieces are short");
-    for (std::uint64_t k = 0; k < piece_count[p]; ++k, ++at) pieces_[p].push_back({piece_element[at], piece_fraction[at]});
+    for (std::uint64_t k = 0; k < piece_count[p]; ++k, ++at)
+      pieces_[p].push_back({piece_element[at], piece_fraction[at]});
   }
   in.get("interface.mismatch", interface_mismatch_);
   in.get("interface.residual", interface_residual_);

@@ -37,12 +37,10 @@ class StateWriter {
   void put(const std::string& name, double value) { f64(name, {value}); }
   void put(const std::string& name, const std::vector<double>& values) { f64(name, values); }
   template <class T>
-    requires std::is_integral_v<T>
-  void put(const std::string& name, T value) {
-    u64(name, {static_cast<std::uint64_t>(value)});
-  }
+  requires std::is_integral_v<T>
+  void put(const std::string& name, T value) { u64(name, {static_cast<std::uint64_t>(value)}); }
   template <class T>
-    requires std::is_integral_v<T>
+  requires std::is_integral_v<T>
   void put(const std::string& name, const std::vector<T>& values) {
     std::vector<std::uint64_t> wide(values.size());
     std::transform(values.begin(), values.end(), wide.begin(), [](T v) { return static_cast<std::uint64_t>(v); });
@@ -50,8 +48,7 @@ class StateWriter {
   }
   // Fixed-size Eigen vectors and matrices, flattened in their storage order.
   template <class M>
-    requires(M::SizeAtCompileTime > 0)
-  void put(const std::string& name, const std::vector<M>& values) {
+  requires(M::SizeAtCompileTime > 0) void put(const std::string& name, const std::vector<M>& values) {
     constexpr auto k = static_cast<std::size_t>(M::SizeAtCompileTime);
     std::vector<double> flat(values.size() * k);
     for (std::size_t i = 0; i < values.size(); ++i) std::copy_n(values[i].data(), k, flat.data() + i * k);
@@ -70,12 +67,10 @@ class StateReader {
   void get(const std::string& name, double& value) const { value = one(f64(name), name); }
   void get(const std::string& name, std::vector<double>& values) const { values = f64(name); }
   template <class T>
-    requires std::is_integral_v<T>
-  void get(const std::string& name, T& value) const {
-    value = static_cast<T>(one(u64(name), name));
-  }
+  requires std::is_integral_v<T>
+  void get(const std::string& name, T& value) const { value = static_cast<T>(one(u64(name), name)); }
   template <class T>
-    requires std::is_integral_v<T>
+  requires std::is_integral_v<T>
   void get(const std::string& name, std::vector<T>& values) const {
     const auto wide = u64(name);
     std::vector<T> narrow;
@@ -84,8 +79,7 @@ class StateReader {
     values = std::move(narrow);
   }
   template <class M>
-    requires(M::SizeAtCompileTime > 0)
-  void get(const std::string& name, std::vector<M>& values) const {
+  requires(M::SizeAtCompileTime > 0) void get(const std::string& name, std::vector<M>& values) const {
     constexpr auto k = static_cast<std::size_t>(M::SizeAtCompileTime);
     const auto flat = f64(name);
     if (flat.size() % k != 0) {
