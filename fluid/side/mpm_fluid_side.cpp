@@ -31,11 +31,14 @@ class MpmFluidSide final : public coupling::SideModel {
     max_substeps_ = std::max<std::uint32_t>(1, f.max_substeps());
     output_dir_ = output_dir;
     title_ = "hfmpm fluid: " + scene.name();
-    // Opened at the first frame, or continued by a restart (load_checkpoint).
-    if (scene.output().hdf5()) frames_file_ = "fluid.h5";
+    if (scene.output().hdf5()) {
+      frames_file_ = "fluid.h5";
+      if (!restarting_) open_writer();  // a restart continues the file instead (load_checkpoint)
+    }
   }
 
   bool can_checkpoint() const override { return true; }
+  void will_restart() override { restarting_ = true; }
   void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
     output::write_checkpoint(path, stamp, [&](StateWriter& out) {
       std::vector<std::uint32_t> ids;
@@ -228,7 +231,7 @@ class MpmFluidSide final : public coupling::SideModel {
     writer_.reset();
     writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
   }
-  // The frame file, created at the first frame.
+  // The frame file, created in setup() (or at the first frame after a restart without one).
   bool open_writer() {
     if (!writer_ && !frames_file_.empty()) {
       writer_.emplace(output_dir_ + "/" + frames_file_, title_);
@@ -239,6 +242,7 @@ class MpmFluidSide final : public coupling::SideModel {
 
   mpm::FluidConfig config_;
   std::string output_dir_, title_, frames_file_;  // frames_file_: empty without output.hdf5
+  bool restarting_ = false;                       // will_restart(): setup() leaves the frame file alone
   std::set<std::uint32_t> listed_;
   std::optional<scene::FluidFill> fill_;
   std::uint32_t max_substeps_ = 1;

@@ -159,10 +159,11 @@ class SideRuntime {
     const std::string& chosen = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
     const std::string output_dir = chosen.empty() ? std::string(".") : chosen;
     std::filesystem::create_directories(output_dir);
+    const bool restart = welcome_.has_restart();
+    if (restart) model_.will_restart();
     model_.setup(scene, output_dir);
     set_up_ = true;
     output_dir_ = output_dir;
-    const bool restart = welcome_.has_restart();
     if (restart) {
       // The state after the checkpoint's step, with what each side last
       // received from the other: no step-0 exchange.

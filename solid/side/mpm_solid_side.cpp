@@ -47,10 +47,13 @@ class MpmSolidSide final : public coupling::SideModel {
     }
     output_dir_ = output_dir;
     title_ = "hfmpm solid: " + scene.name();
-    // Opened at the first frame, or continued by a restart (load_checkpoint).
-    if (scene.output().hdf5()) frames_file_ = "solid.h5";
+    if (scene.output().hdf5()) {
+      frames_file_ = "solid.h5";
+      if (!restarting_) open_writer();  // a restart continues the file instead (load_checkpoint)
+    }
   }
   bool can_checkpoint() const override { return true; }
+  void will_restart() override { restarting_ = true; }
   void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
     output::write_checkpoint(path, stamp, [&](StateWriter& out) {
       PrefixedWriter solver(out, "solid.");
@@ -215,7 +218,7 @@ class MpmSolidSide final : public coupling::SideModel {
     writer_.reset();
     writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
   }
-  // The frame file, created at the first frame.
+  // The frame file, created in setup() (or at the first frame after a restart without one).
   bool open_writer() {
     if (!writer_ && !frames_file_.empty()) {
       writer_.emplace(output_dir_ + "/" + frames_file_, title_);
@@ -226,6 +229,7 @@ class MpmSolidSide final : public coupling::SideModel {
 
   std::optional<mpm::Solver> solver_;
   std::string output_dir_, title_, frames_file_;  // frames_file_: empty without output.hdf5
+  bool restarting_ = false;                       // will_restart(): setup() leaves the frame file alone
   std::vector<std::optional<TimeFunction>> prescribed_;
   bool implicit_ = false;               // coupling.scheme IMPLICIT: publish the faces' response
   std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)

@@ -54,6 +54,9 @@ class SideModel {
   // `stamp`; load_checkpoint, called after setup() instead of the step-0
   // exchange, restores it and refuses a file whose stamp differs.
   virtual bool can_checkpoint() const { return false; }
+  // Called before setup() when the run continues from a checkpoint (load_checkpoint
+  // follows setup): setup() must then leave the files a restart continues alone.
+  virtual void will_restart() {}
   virtual void save_checkpoint(const std::string& /*path*/, const CheckpointStamp& /*stamp*/) {
     throw InputError("this side cannot write checkpoints");
   }
