@@ -7,6 +7,7 @@
 #include <set>
 
 #include "hfmpm/fluid/mpm/solver.hpp"
+#include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/frame_writer.hpp"
 #include "hfmpm/proto/convert.hpp"
 
@@ -28,10 +29,48 @@ class MpmFluidSide final : public coupling::SideModel {
     listed_.insert(f.crack_ids().begin(), f.crack_ids().end());
     if (f.has_initial_fill()) fill_ = f.initial_fill();
     max_substeps_ = std::max<std::uint32_t>(1, f.max_substeps());
+    output_dir_ = output_dir;
+    title_ = "hfmpm fluid: " + scene.name();
     if (scene.output().hdf5()) {
-      writer_.emplace(output_dir + "/fluid.h5", "hfmpm fluid: " + scene.name());
-      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+      frames_file_ = "fluid.h5";
+      if (!restarting_) open_writer();  // a restart continues the file instead (load_checkpoint)
     }
+  }
+
+  bool can_checkpoint() const override { return true; }
+  void will_restart() override { restarting_ = true; }
+  void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::write_checkpoint(path, stamp, [&](StateWriter& out) {
+      std::vector<std::uint32_t> ids;
+      for (const auto& c : cracks_) {
+        ids.push_back(c.id);
+        PrefixedWriter solver(out, "fluid" + std::to_string(c.id) + ".");
+        c.solver.save(solver);
+      }
+      out.put("side.cracks", ids);
+      out.put("side.received", static_cast<int>(received_));
+      out.put("side.substeps", substeps_);
+      out.put("side.steps", steps_);
+      save_frames(out);
+    });
+  }
+  void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::read_checkpoint(path, stamp, [&](const StateReader& in) {
+      std::vector<std::uint32_t> ids;
+      in.get("side.cracks", ids);
+      std::vector<FluidCrack> restored(ids.size(), FluidCrack{0, mpm::FluidSolver(config_)});
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        restored[i].id = ids[i];
+        restored[i].solver.load(PrefixedReader(in, "fluid" + std::to_string(ids[i]) + "."));
+      }
+      cracks_ = std::move(restored);
+      int received = 0;
+      in.get("side.received", received);
+      received_ = received != 0;
+      in.get("side.substeps", substeps_);
+      in.get("side.steps", steps_);
+      resume_frames(in);
+    });
   }
 
   // The coupled step may hold max_substeps fluid steps (the fluid subcycles).
@@ -132,7 +171,7 @@ class MpmFluidSide final : public coupling::SideModel {
   }
 
   void write_output(std::uint64_t /*frame*/, double t) override {
-    if (!writer_) return;
+    if (!open_writer()) return;
     writer_->begin_frame(t, steps_of_first());
     for (const auto& c : cracks_) {
       const auto& s = c.solver;
@@ -177,7 +216,33 @@ class MpmFluidSide final : public coupling::SideModel {
   }
   std::uint64_t steps_of_first() const { return cracks_.empty() ? 0 : cracks_.front().solver.steps(); }
 
+  // The frame file's state goes into a checkpoint; a restart continues the
+  // file from it (frames a killed run wrote after the checkpoint go).
+  void save_frames(StateWriter& out) const {
+    out.put("side.frames", writer_ ? 1 : 0);
+    if (!writer_) return;
+    PrefixedWriter frames(out, "frames.");
+    writer_->save(frames);
+  }
+  void resume_frames(const StateReader& in) {
+    int frames = 0;
+    in.get("side.frames", frames);
+    if (frames == 0 || frames_file_.empty()) return;
+    writer_.reset();
+    writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
+  }
+  // The frame file, created in setup() (or at the first frame after a restart without one).
+  bool open_writer() {
+    if (!writer_ && !frames_file_.empty()) {
+      writer_.emplace(output_dir_ + "/" + frames_file_, title_);
+      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+    }
+    return writer_.has_value();
+  }
+
   mpm::FluidConfig config_;
+  std::string output_dir_, title_, frames_file_;  // frames_file_: empty without output.hdf5
+  bool restarting_ = false;                       // will_restart(): setup() leaves the frame file alone
   std::set<std::uint32_t> listed_;
   std::optional<scene::FluidFill> fill_;
   std::uint32_t max_substeps_ = 1;

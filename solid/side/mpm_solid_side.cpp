@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 
+#include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/frame_writer.hpp"
 #include "hfmpm/proto/convert.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
@@ -44,10 +45,30 @@ class MpmSolidSide final : public coupling::SideModel {
                                 ? std::optional<TimeFunction>(proto::to_time_function(crack.pressure_pa()))
                                 : std::nullopt);
     }
+    output_dir_ = output_dir;
+    title_ = "hfmpm solid: " + scene.name();
     if (scene.output().hdf5()) {
-      writer_.emplace(output_dir + "/solid.h5", "hfmpm solid: " + scene.name());
-      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+      frames_file_ = "solid.h5";
+      if (!restarting_) open_writer();  // a restart continues the file instead (load_checkpoint)
     }
+  }
+  bool can_checkpoint() const override { return true; }
+  void will_restart() override { restarting_ = true; }
+  void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::write_checkpoint(path, stamp, [&](StateWriter& out) {
+      PrefixedWriter solver(out, "solid.");
+      solver_->save(solver);
+      out.put("side.published", published_);
+      save_frames(out);
+    });
+  }
+  void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::read_checkpoint(path, stamp, [&](const StateReader& in) {
+      PrefixedReader solver(in, "solid.");
+      solver_->load(solver);
+      in.get("side.published", published_);
+      resume_frames(in);
+    });
   }
   double stable_dt() const override { return solver_->stable_dt(); }
   std::string stable_dt_limit() const override {
@@ -114,7 +135,7 @@ class MpmSolidSide final : public coupling::SideModel {
     return d;
   }
   void write_output(std::uint64_t /*frame*/, double t) override {
-    if (!writer_) return;
+    if (!open_writer()) return;
     const auto& p = solver_->particles();
     writer_->begin_frame(t, solver_->steps());
     writer_->points("particles", p.x);
@@ -182,7 +203,33 @@ class MpmSolidSide final : public coupling::SideModel {
     return g;
   }
 
+  // The frame file's state goes into a checkpoint; a restart continues the
+  // file from it (frames a killed run wrote after the checkpoint go).
+  void save_frames(StateWriter& out) const {
+    out.put("side.frames", writer_ ? 1 : 0);
+    if (!writer_) return;
+    PrefixedWriter frames(out, "frames.");
+    writer_->save(frames);
+  }
+  void resume_frames(const StateReader& in) {
+    int frames = 0;
+    in.get("side.frames", frames);
+    if (frames == 0 || frames_file_.empty()) return;
+    writer_.reset();
+    writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
+  }
+  // The frame file, created in setup() (or at the first frame after a restart without one).
+  bool open_writer() {
+    if (!writer_ && !frames_file_.empty()) {
+      writer_.emplace(output_dir_ + "/" + frames_file_, title_);
+      writer_->attribute("units", "SI; 2D quantities per unit thickness");
+    }
+    return writer_.has_value();
+  }
+
   std::optional<mpm::Solver> solver_;
+  std::string output_dir_, title_, frames_file_;  // frames_file_: empty without output.hdf5
+  bool restarting_ = false;                       // will_restart(): setup() leaves the frame file alone
   std::vector<std::optional<TimeFunction>> prescribed_;
   bool implicit_ = false;               // coupling.scheme IMPLICIT: publish the faces' response
   std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hfmpm/exchange.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::solid::mpm {
 
@@ -74,6 +75,11 @@ class Crack {
   // `position` (growth that lengthens the tip segment instead of adding one);
   // it stays closed.
   void move_tip(bool at_end, const Vec2& position);
+
+  // Checkpoints: every member but the id and the tip flags (which the scene fixes); load()
+  // restores this crack bit for bit (solid/src/mpm/checkpoint.cpp).
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
 
  private:
   std::uint32_t id_;
