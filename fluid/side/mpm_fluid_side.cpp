@@ -8,7 +8,7 @@
 
 #include "hfmpm/fluid/mpm/solver.hpp"
 #include "hfmpm/output/checkpoint_file.hpp"
-#include "hfmpm/output/frame_writer.hpp"
+#include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
 
 namespace hfmpm::fluid {
@@ -29,16 +29,11 @@ class MpmFluidSide final : public coupling::SideModel {
     listed_.insert(f.crack_ids().begin(), f.crack_ids().end());
     if (f.has_initial_fill()) fill_ = f.initial_fill();
     max_substeps_ = std::max<std::uint32_t>(1, f.max_substeps());
-    output_dir_ = output_dir;
-    title_ = "hfmpm fluid: " + scene.name();
-    if (scene.output().hdf5()) {
-      frames_file_ = "fluid.h5";
-      if (!restarting_) open_writer();  // a restart continues the file instead (load_checkpoint)
-    }
+    frames_.setup(scene.output().hdf5() ? output_dir + "/fluid.h5" : std::string(), "hfmpm fluid: " + scene.name());
   }
 
   bool can_checkpoint() const override { return true; }
-  void will_restart() override { restarting_ = true; }
+  void will_restart() override { frames_.will_restart(); }
   void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
     output::write_checkpoint(path, stamp, [&](StateWriter& out) {
       std::vector<std::uint32_t> ids;
@@ -51,7 +46,7 @@ class MpmFluidSide final : public coupling::SideModel {
       out.put("side.received", static_cast<int>(received_));
       out.put("side.substeps", substeps_);
       out.put("side.steps", steps_);
-      save_frames(out);
+      frames_.save(out);
     });
   }
   void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
@@ -69,7 +64,7 @@ class MpmFluidSide final : public coupling::SideModel {
       received_ = received != 0;
       in.get("side.substeps", substeps_);
       in.get("side.steps", steps_);
-      resume_frames(in);
+      frames_.resume(in);
     });
   }
 
@@ -171,26 +166,27 @@ class MpmFluidSide final : public coupling::SideModel {
   }
 
   void write_output(std::uint64_t /*frame*/, double t) override {
-    if (!open_writer()) return;
-    writer_->begin_frame(t, steps_of_first());
+    output::FrameWriter* writer = frames_.writer();
+    if (!writer) return;
+    writer->begin_frame(t, steps_of_first());
     for (const auto& c : cracks_) {
       const auto& s = c.solver;
       const auto& p = s.particles();
       const std::string id = std::to_string(c.id);
-      writer_->points("fluid" + id, s.particle_positions());
-      writer_->scalar("fluid" + id, "arc_length", p.s);
-      writer_->scalar("fluid" + id, "length", p.length);
-      writer_->scalar("fluid" + id, "width", p.width);
-      writer_->scalar("fluid" + id, "pressure", p.pressure);
-      writer_->scalar("fluid" + id, "velocity", p.velocity);
-      writer_->scalar("fluid" + id, "mass", p.mass);
+      writer->points("fluid" + id, s.particle_positions());
+      writer->scalar("fluid" + id, "arc_length", p.s);
+      writer->scalar("fluid" + id, "length", p.length);
+      writer->scalar("fluid" + id, "width", p.width);
+      writer->scalar("fluid" + id, "pressure", p.pressure);
+      writer->scalar("fluid" + id, "velocity", p.velocity);
+      writer->scalar("fluid" + id, "mass", p.mass);
       const auto& g = s.grid();
-      writer_->points("nodes" + id, g.position());
-      writer_->scalar("nodes" + id, "arc_length", g.arc());
-      writer_->scalar("nodes" + id, "width", g.width());
-      writer_->scalar("nodes" + id, "pressure", s.nodal_pressure());
+      writer->points("nodes" + id, g.position());
+      writer->scalar("nodes" + id, "arc_length", g.arc());
+      writer->scalar("nodes" + id, "width", g.width());
+      writer->scalar("nodes" + id, "pressure", s.nodal_pressure());
     }
-    writer_->end_frame();
+    writer->end_frame();
   }
 
  private:
@@ -216,40 +212,14 @@ class MpmFluidSide final : public coupling::SideModel {
   }
   std::uint64_t steps_of_first() const { return cracks_.empty() ? 0 : cracks_.front().solver.steps(); }
 
-  // The frame file's state goes into a checkpoint; a restart continues the
-  // file from it (frames a killed run wrote after the checkpoint go).
-  void save_frames(StateWriter& out) const {
-    out.put("side.frames", writer_ ? 1 : 0);
-    if (!writer_) return;
-    PrefixedWriter frames(out, "frames.");
-    writer_->save(frames);
-  }
-  void resume_frames(const StateReader& in) {
-    int frames = 0;
-    in.get("side.frames", frames);
-    if (frames == 0 || frames_file_.empty()) return;
-    writer_.reset();
-    writer_.emplace(output_dir_ + "/" + frames_file_, PrefixedReader(in, "frames."));
-  }
-  // The frame file, created in setup() (or at the first frame after a restart without one).
-  bool open_writer() {
-    if (!writer_ && !frames_file_.empty()) {
-      writer_.emplace(output_dir_ + "/" + frames_file_, title_);
-      writer_->attribute("units", "SI; 2D quantities per unit thickness");
-    }
-    return writer_.has_value();
-  }
-
   mpm::FluidConfig config_;
-  std::string output_dir_, title_, frames_file_;  // frames_file_: empty without output.hdf5
-  bool restarting_ = false;                       // will_restart(): setup() leaves the frame file alone
   std::set<std::uint32_t> listed_;
   std::optional<scene::FluidFill> fill_;
   std::uint32_t max_substeps_ = 1;
   std::vector<FluidCrack> cracks_;
   bool received_ = false;
   std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
-  std::optional<output::FrameWriter> writer_;
+  output::SideFrames frames_;               // the frame file (solid.h5 / fluid.h5) across restarts
 };
 
 }  // namespace

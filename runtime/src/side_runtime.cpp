@@ -20,6 +20,7 @@
 #include "hfmpm/proto/convert.hpp"
 #include "hfmpm/runtime/coupling_scheme.hpp"
 #include "hfmpm/runtime/zmq_transport.hpp"
+#include "side_checkpoint.hpp"
 #include "side_checks.hpp"
 
 namespace hfmpm::coupling {
@@ -171,7 +172,7 @@ class SideRuntime {
       step_ = r.step();
       t_ = r.t();
       heartbeat_step_ = step_;
-      model_.load_checkpoint(checkpoint_path(r.directory()), stamp(r.step(), r.t()));
+      model_.load_checkpoint(checkpoint_path(output_dir_, r.directory(), role_), stamp(r.step(), r.t()));
     }
     if (scene.output().exchange_log()) {
       log_ = std::make_unique<ExchangeLog>(output_dir, role_,
@@ -271,28 +272,8 @@ class SideRuntime {
     }
   }
 
-  // <output dir>/<directory>/<role>.h5; the directory must stay inside the output directory.
-  std::string checkpoint_path(const std::string& directory) const {
-    if (directory.empty() || directory.front() == '/' || directory.find("..") != std::string::npos) {
-      throw proto::ProtocolError("checkpoint directory '" + printable(directory) +
-                                 "' must be a relative path inside the output directory");
-    }
-    const std::filesystem::path dir = std::filesystem::path(output_dir_) / directory;
-    std::filesystem::create_directories(dir);
-    return (dir / (role_ + ".h5")).string();
-  }
-
   CheckpointStamp stamp(std::uint64_t step, double t) const {
-    CheckpointStamp s;
-    s.role = role_;
-    s.implementation = options_.implementation;
-    s.program_version = options_.implementation_version;
-    s.protocol_version = options_.protocol_version;
-    s.scene_schema_version = options_.scene_schema_version;
-    s.scene_hash = proto::scene_hash(welcome_.scene());
-    s.step = step;
-    s.t = t;
-    return s;
+    return checkpoint_stamp(options_, role_, welcome_.scene(), step, t);
   }
 
   void check_command(const protocol::StepCommand& command) const {
@@ -332,15 +313,8 @@ class SideRuntime {
     publish_compute_s_ = 0;
     if (command.write_output()) model_.write_output(command.output_frame(), t_);
     if (command.checkpoint()) {
-      const auto start = Clock::now();
-      const std::string path = checkpoint_path(command.checkpoint_directory());
-      model_.save_checkpoint(path, stamp(step_, t_));
-      const double took = seconds_since(start);
-      compute_s += took;
-      std::error_code size_error;
-      const auto bytes = std::filesystem::file_size(path, size_error);
-      std::cerr << role_ << ": checkpoint " << path << " written in " << took << " s ("
-                << (size_error ? 0.0 : static_cast<double>(bytes) / 1e6) << " MB)\n";
+      const std::string path = checkpoint_path(output_dir_, command.checkpoint_directory(), role_);
+      compute_s += write_side_checkpoint(model_, path, stamp(step_, t_), role_);
     }
 
     protocol::Envelope envelope;
