@@ -24,6 +24,10 @@ using namespace hfmpm;
 constexpr const char* kUsage = R"(usage:
   hfmpm run SCENE [--out DIR] [--set KEY=VALUE]... [--transport ipc|tcp|inproc] [--quiet]
       Start the coupler and both sides, run SCENE to its end time, write DIR/history.csv.
+  hfmpm run --restart DIR [SCENE [--set KEY=VALUE]...] [--transport ...] [--quiet]
+      Continue the run in DIR from its last complete checkpoint (the scene needs
+      output.checkpoint_interval_s > 0), also after kill -9. Without SCENE the
+      checkpoint's own scene is used; a SCENE (with its --set) must be the same scene.
   hfmpm coupler SCENE --bind ENDPOINT [--keys FILE] [--out DIR] [--set KEY=VALUE]... [--quiet]
       Run the coupler only and wait for the sides to join, e.g. from other hosts:
         hfmpm keygen keys      (once; copy keys/side.keys to the sides' hosts)
@@ -48,6 +52,7 @@ options:
                        who can reach the port can join. 'run' makes keys itself.
   --solid-program P    run another solid implementation (speaks docs/protocol.md)
   --fluid-program P    run another fluid implementation
+  --restart DIR        run: continue the run in DIR from its last complete checkpoint
   --quiet              no progress line
   --help, -h           this text (also after a command: hfmpm run --help)
 exit status: 0 success, 1 run failed, 2 bad scene or command line,
@@ -93,7 +98,7 @@ int keygen(const std::vector<std::string>& args) {
 }
 
 int run(const std::string& command, const std::vector<std::string>& args) {
-  std::string scene_path, out, bind;
+  std::string scene_path, out, bind, restart;
   std::vector<std::string> overrides;
   bool json = false;  // validate: print JSON
   coupling::RunOptions options;
@@ -110,7 +115,10 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       }
     } else if (arg == "--set")
       overrides.push_back(value());
-    else if (arg == "--bind")
+    else if (arg == "--restart") {
+      restart = value();
+      if (restart.empty()) throw UsageError("--restart needs the run directory to continue");
+    } else if (arg == "--bind")
       bind = value();
     else if (arg == "--quiet")
       options.progress = false;
@@ -136,8 +144,36 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     else
       throw UsageError("more than one scene given ('" + scene_path + "' and '" + arg + "')");
   }
-  if (scene_path.empty()) throw UsageError("no scene file given");
-  const scene::Scene scene = coupling::load_scene(scene_path, overrides);
+  std::shared_ptr<coupling::RestartPoint> restart_point;
+  if (!restart.empty()) {
+    if (command != "run") throw UsageError("--restart is for 'hfmpm run'");
+    if (!out.empty()) throw UsageError("--restart DIR continues in DIR; --out is not allowed with it");
+    if (scene_path.empty() && !overrides.empty()) {
+      throw UsageError(
+          "--set and --transport need the scene file: hfmpm run --restart DIR SCENE --set ... (the run's own scene "
+          "and overrides; without SCENE the checkpoint's scene is used as it is)");
+    }
+    try {
+      restart_point = std::make_shared<coupling::RestartPoint>(coupling::find_restart(restart));
+    } catch (const coupling::RestartError& e) {
+      std::cerr << "hfmpm: " << e.what() << "\n";
+      return 2;
+    }
+  }
+  if (scene_path.empty() && !restart_point) throw UsageError("no scene file given");
+  const scene::Scene scene =
+      scene_path.empty() ? restart_point->state.scene() : coupling::load_scene(scene_path, overrides);
+  if (restart_point) {
+    try {
+      coupling::check_restart_scene(*restart_point, scene);
+    } catch (const coupling::RestartError& e) {
+      std::cerr << "hfmpm: " << e.what() << "\n";
+      return 2;
+    }
+    out = restart;
+    options.restart = restart_point;
+    if (scene_path.empty()) scene_path = restart + "/" + restart_point->directory + "/coupler.pb";
+  }
   if (json && command != "validate") throw UsageError("--json is for 'hfmpm validate'");
   if (command == "validate") {
     const scene::Scene filled = coupling::with_defaults(scene);

@@ -3,7 +3,10 @@
 // and tcp, exchanging every step and every 10 steps. The yardstick is a bare
 // ZeroMQ PAIR round trip of 64 bytes on the same transport, measured here.
 //
-//   build/release/bin/hfmpm-bench-coupling [--steps N] [--quick]
+//   build/release/bin/hfmpm-bench-coupling [--steps N] [--quick] [--particles N,N,...] [--transports T,T,...]
+//
+// --particles: crack particle counts (default 100,1000,5000; --quick: 100);
+// --transports: any of inproc, ipc, tcp (default all three).
 //
 // Prints a Markdown table (docs/performance.md holds a copy with the machine).
 #include <unistd.h>
@@ -11,6 +14,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -109,20 +113,44 @@ coupling::RunSummary run_case(const Case& c, int steps, const std::string& scene
 
 int main(int argc, char** argv) {
   int steps = 4000;
-  bool quick = false;
+  std::vector<int> sizes{100, 1000, 5000};
+  std::vector<std::string> transports{"inproc", "ipc", "tcp"};
+  auto split = [](const std::string& text) {
+    std::vector<std::string> items;
+    std::stringstream list(text);
+    for (std::string item; std::getline(list, item, ',');) items.push_back(item);
+    return items;
+  };
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--steps" && i + 1 < argc)
+    if (arg == "--steps" && i + 1 < argc) {
       steps = std::stoi(argv[++i]);
-    else if (arg == "--quick")
-      quick = true;
-    else {
-      std::cerr << "usage: hfmpm-bench-coupling [--steps N] [--quick]\n";
+    } else if (arg == "--quick") {
+      sizes = {100};
+    } else if (arg == "--particles" && i + 1 < argc) {
+      sizes.clear();
+      for (const auto& item : split(argv[++i])) {
+        const int n = std::atoi(item.c_str());
+        if (n < 2 || n > 1000000) {
+          std::cerr << "--particles: each count must be an integer in [2, 1e6], got '" << item << "'\n";
+          return 2;
+        }
+        sizes.push_back(n);
+      }
+    } else if (arg == "--transports" && i + 1 < argc) {
+      transports = split(argv[++i]);
+      for (const auto& t : transports) {
+        if (t != "inproc" && t != "ipc" && t != "tcp") {
+          std::cerr << "--transports: each must be inproc, ipc or tcp, got '" << t << "'\n";
+          return 2;
+        }
+      }
+    } else {
+      std::cerr << "usage: hfmpm-bench-coupling [--steps N] [--quick] [--particles N,N,...] [--transports T,T,...]\n";
       return 2;
     }
   }
   const std::string scene_path = std::string(HFMPM_SOURCE_DIR) + "/scenarios/prescribed.scene";
-  const std::vector<std::string> transports{"inproc", "ipc", "tcp"};
 
   std::cout << "64-byte ZeroMQ PAIR round trip between two threads (median of 2000):\n\n"
             << "| transport | round trip (us) |\n|---|---|\n";
@@ -136,7 +164,7 @@ int main(int argc, char** argv) {
             << "| crack particles | transport | exchange every | control round every | steps/s | overhead (us/step) "
                "| overhead per exchange / round trip |\n|---|---|---|---|---|---|---|\n";
   std::vector<Case> cases;
-  for (int n : quick ? std::vector<int>{100} : std::vector<int>{100, 1000, 5000}) {
+  for (int n : sizes) {
     for (const auto& t : transports) {
       cases.push_back({n, t, 1, 1});
       cases.push_back({n, t, 1, 20});

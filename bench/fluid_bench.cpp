@@ -3,11 +3,16 @@
 // outlet (steady Poiseuille flow, so every step moves fluid through the inlet
 // and the outlet as well as the interior). One thread: the fluid is serial.
 //
-//   build/release/bin/hfmpm-bench-fluid [--steps S]
+//   build/release/bin/hfmpm-bench-fluid [--steps S] [--cells N,N,...]
+//
+// --cells: the channel's element counts (default 100,1000,10000); counts of
+// 10,000 and more run a tenth of the steps.
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "hfmpm/fluid/mpm/solver.hpp"
 
@@ -64,12 +69,24 @@ Result run(int cells, int steps) {
 
 int main(int argc, char** argv) {
   int steps = 20000;
+  std::vector<int> sizes{100, 1000, 10000};
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--steps" && i + 1 < argc) {
       steps = std::atoi(argv[++i]);
+    } else if (arg == "--cells" && i + 1 < argc) {
+      sizes.clear();
+      std::stringstream list(argv[++i]);
+      for (std::string item; std::getline(list, item, ',');) {
+        const int n = std::atoi(item.c_str());
+        if (n < 2 || n > 10000000) {
+          std::fprintf(stderr, "--cells: each count must be an integer in [2, 1e7], got '%s'\n", item.c_str());
+          return 2;
+        }
+        sizes.push_back(n);
+      }
     } else {
-      std::fprintf(stderr, "usage: %s [--steps S]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--steps S] [--cells N,N,...]\n", argv[0]);
       return 2;
     }
   }
@@ -79,7 +96,7 @@ int main(int argc, char** argv) {
   }
   std::printf("fluid 1D MPM, filled channel with inlet and outlet flow, 1 thread, %d steps\n", steps);
   std::printf("%8s %10s %10s %16s %14s\n", "nodes", "particles", "wall_s", "particle-steps/s", "ns/part-step");
-  for (int cells : {100, 1000, 10000}) {
+  for (int cells : sizes) {
     const int n = cells >= 10000 ? std::max(1, steps / 10) : steps;
     const Result r = run(cells, n);
     std::printf("%8d %10zu %10.3f %16.3e %14.1f\n", cells + 1, r.particles, r.wall, r.rate, 1e9 / r.rate);

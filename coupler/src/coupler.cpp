@@ -143,7 +143,7 @@ void Coupler::report_rest() {
 void Coupler::prepare() {
   fs::create_directories(options_.output_dir);
   output_dir_ = fs::absolute(options_.output_dir).string();
-  log_.open(output_dir_ + "/coupler.log", options_.progress);
+  log_.open(output_dir_ + "/coupler.log", options_.progress, options_.restart != nullptr);
   manifest_ = Manifest(output_dir_ + "/run.json");
   run_id_ = random_id();
   manifest_.set("run_id", run_id_);
@@ -160,7 +160,25 @@ void Coupler::prepare() {
   manifest_.set("overrides", overrides);
   manifest_.set_number("protocol_version", proto::kProtocolVersion);
   prepared_ = true;
-  history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
+  if (options_.restart) {
+    // Continue the run's history after the checkpoint's row (the rows a killed
+    // run wrote after it go; the restart writes them again).
+    const auto& r = *options_.restart;
+    step_ = r.state.step();
+    t_ = r.state.t();
+    truncate_history(output_dir_ + "/history.csv", step_);
+    history_ = std::make_unique<History>(output_dir_ + "/history.csv", true);
+    manifest_.set("restarted_from", r.directory);
+    manifest_.set_number("restart_step", static_cast<double>(step_));
+    manifest_.set_number("restart_time_s", t_);
+    manifest_.set("restarted_run_id", r.state.run_id());
+    log_("restarting from " + r.directory + " (step " + std::to_string(step_) + ", t = " + std::to_string(t_) + " s)");
+  } else {
+    history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
+  }
+  if (scene_.output().checkpoint_interval_s() > 0) {
+    manifest_.set_number("checkpoint_interval_s", scene_.output().checkpoint_interval_s());
+  }
   {
     // The scene the run uses, every default filled in, as JSON: what a plot
     // or a script reads instead of repeating the scene's values.
@@ -335,7 +353,7 @@ void Coupler::launch_sides() {
     side.log_path = output_dir_ + "/" + side.name + ".log";
     const std::string program = program_for(side);
     try {
-      side.process = std::make_unique<ChildProcess>(program, args, side.log_path);
+      side.process = std::make_unique<ChildProcess>(program, args, side.log_path, options_.restart != nullptr);
     } catch (const std::exception& e) {
       throw RunFailure{"cannot start the " + side.name + " side: " + e.what()};
     }

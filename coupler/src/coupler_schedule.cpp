@@ -1,5 +1,7 @@
 // The handshake (Hello, Welcome, Listening, Ready) and the step schedule:
 // dt, blocks of steps, reports, output rows, stuck sides.
+#include <algorithm>
+
 #include "coupler_session.hpp"
 
 namespace hfmpm::coupling::detail {
@@ -66,6 +68,12 @@ protocol::Envelope Coupler::welcome_for(protocol::DataPlane::Mode mode, const st
   welcome->set_output_dir(output_dir_);
   welcome->mutable_data_plane()->set_mode(mode);
   if (mode != protocol::DataPlane::NONE) welcome->mutable_data_plane()->set_endpoint(endpoint);
+  if (options_.restart) {
+    auto* restart = welcome->mutable_restart();
+    restart->set_step(options_.restart->state.step());
+    restart->set_t(options_.restart->state.t());
+    restart->set_directory(options_.restart->directory);
+  }
   return envelope;
 }
 
@@ -88,6 +96,15 @@ void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelop
                        (hello.scene_schema_version() == 0 ? " (before scenes were versioned)" : "") +
                        "; this coupler's scenes are version " + std::to_string(proto::kSceneSchemaVersion) +
                        ": build the side from the same scene.proto (docs/protocol.md, \"Versions\")");
+    }
+    side.can_checkpoint = std::find(hello.capabilities().begin(), hello.capabilities().end(),
+                                    std::string(kCheckpointCapability)) != hello.capabilities().end();
+    if (!side.can_checkpoint && (options_.restart || scene_.output().checkpoint_interval_s() > 0)) {
+      reject(side, who + " cannot " +
+                       (options_.restart ? std::string("restart from a checkpoint")
+                                         : std::string("write checkpoints (output.checkpoint_interval_s = ") +
+                                               std::to_string(scene_.output().checkpoint_interval_s()) + ")") +
+                       ": its Hello does not list the capability \"checkpoint\"");
     }
     side.joined = true;
     side.implementation = hello.implementation() + " " + hello.implementation_version();
@@ -176,27 +193,41 @@ std::string check_step_count(const scene::Scene& scene, double t, double dt, dou
 void Coupler::step_loop(RunSummary& summary) {
   History& history = *history_;
   const auto start = Clock::now();
+  stepping_start_ = start;
   const double end = scene_.time().end_s();
   const double interval = output_interval(scene_);
   const std::uint32_t k = CouplingScheme::of(scene_).exchange_interval();  // 1 in a dry run
   const std::uint64_t block = (std::uint64_t{scene_.coupling().control_interval()} + k - 1) / k * k;
-  double dt = next_dt();
-  if (const auto warning = check_step_count(scene_, t_, dt, end, dt_limit_, at_step()); !warning.empty()) log_(warning);
-  history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+  const double checkpoint_interval = scene_.output().checkpoint_interval_s();
+  Schedule schedule;
   if (sides_[1].expected) {
     energy_ = std::make_unique<EnergyWatch>(scene_.coupling().energy_bound());
-    energy_->start(sides_[1].diagnostics);
   } else {
     rest_ = std::make_unique<RestWatch>(end);
   }
-  std::uint64_t frame = 1;
-  double next_output = interval;
-  double mean_command_s = 0;
+  if (options_.restart) {
+    restore_checkpoint(schedule, summary);  // the step loop's state as it was after the checkpoint's block
+  } else {
+    schedule.dt = next_dt();
+    if (const auto warning = check_step_count(scene_, t_, schedule.dt, end, dt_limit_, at_step()); !warning.empty()) {
+      log_(warning);
+    }
+    history.write(t_, step_, schedule.dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+    if (energy_) energy_->start(sides_[1].diagnostics);
+    schedule.next_output = interval;
+    schedule.next_checkpoint = checkpoint_interval > 0
+                                   ? checkpoint_interval
+                                   : kInf;  // NOLINT(bugprone-narrowing-conversions): clang-tidy 14 misreads inf
+  }
+  double& dt = schedule.dt;
+  std::uint64_t& frame = schedule.frame;
+  double& next_output = schedule.next_output;
+  double& mean_command_s = schedule.mean_command_s;
   const std::uint64_t max_steps = scene_.time().max_steps();
   stepping_ = true;
   while (t_ < end * (1 - 1e-12)) {
     if (options_.stop_request && options_.stop_request->load()) {
-      summary.stepping_wall_s = seconds_since(start);
+      summary.stepping_wall_s = stepping_before_ + seconds_since(start);
       history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
       check_stop_request();
     }
@@ -223,6 +254,13 @@ void Coupler::step_loop(RunSummary& summary) {
     command->set_dt(dt);
     command->set_write_output(output);
     command->set_output_frame(output ? frame : 0);
+    // A checkpoint at the first output row at or after each multiple of the
+    // interval (not at the end: nothing would continue from it).
+    const bool checkpoint =
+        output && t_end >= schedule.next_checkpoint * (1 - 1e-12) && t_end < end * (1 - 1e-12) && !last_allowed;
+    const std::string checkpoint_dir = checkpoint ? checkpoint_directory(step_ + n) : std::string();
+    command->set_checkpoint(checkpoint);
+    command->set_checkpoint_directory(checkpoint_dir);
     const auto command_start = Clock::now();
     for (auto& side : sides_) {
       if (!side.expected) continue;
@@ -266,14 +304,115 @@ void Coupler::step_loop(RunSummary& summary) {
       while (next_output <= t_ * (1 + 1e-12)) next_output += interval;
     }
     if (t_ < end * (1 - 1e-12)) dt = next_dt();
+    if (checkpoint) {
+      for (const auto& side : sides_) {
+        if (side.expected && !side.report->checkpoint_written()) {
+          throw RunFailure{"the " + side.name + " side did not write the checkpoint" + at_step() + " it was asked for"};
+        }
+      }
+      while (schedule.next_checkpoint <= t_ * (1 + 1e-12)) schedule.next_checkpoint += checkpoint_interval;
+      // Both sides have theirs on disk: the coupler's file completes the checkpoint.
+      save_checkpoint(schedule, summary);
+      log_.file_only("checkpoint " + checkpoint_dir + " complete (t = " + std::to_string(t_) + " s)");
+    }
     progress_.update(t_, step_, seconds_since(start));
   }
-  summary.stepping_wall_s = seconds_since(start);
+  summary.stepping_wall_s = stepping_before_ + seconds_since(start);
   if (t_ < end * (1 - 1e-12)) {
     stopped_at_max_steps_ = true;
     log_("stopped at step " + std::to_string(step_) + " (time.max_steps = " + std::to_string(max_steps) +
          ", in whole exchange windows) before time.end_s");
   }
+}
+
+void Coupler::save_checkpoint(const Schedule& schedule, const RunSummary& summary) {
+  checkpoint::CouplerState s;
+  s.set_format(kCouplerCheckpointFormat);
+  s.set_program_version(proto::kProgramVersion);
+  s.set_protocol_version(proto::kProtocolVersion);
+  s.set_scene_schema_version(proto::kSceneSchemaVersion);
+  s.set_scene_hash(proto::scene_hash(scene_));
+  *s.mutable_scene() = scene_;
+  s.set_step(step_);
+  s.set_t(t_);
+  s.set_dt(schedule.dt);
+  s.set_dt_limit(dt_limit_);
+  s.set_frame(schedule.frame);
+  s.set_next_output(schedule.next_output);
+  s.set_next_checkpoint(schedule.next_checkpoint);
+  for (int i = 0; i < 2; ++i) {
+    const Side& side = sides_[i];
+    auto* out = i == 0 ? s.mutable_solid() : s.mutable_fluid();
+    out->set_expected(side.expected);
+    out->set_stable_dt(side.stable_dt);
+    out->set_stable_dt_limit(side.stable_dt_limit);
+    proto::to_proto(side.diagnostics, out->mutable_diagnostics());
+    out->set_compute_s(side.compute_s);
+    out->set_exchange_s(side.exchange_s);
+    out->set_implementation(side.implementation);
+  }
+  if (energy_) {
+    const auto e = energy_->state();
+    s.set_energy_e0(e.e0);
+    s.set_energy_p(e.p);
+    s.set_energy_v(e.v);
+    s.set_energy_work(e.work);
+    s.set_energy_largest(e.largest);
+    s.set_energy_largest_t(e.largest_t);
+  }
+  if (rest_) {
+    const auto r = rest_->state();
+    s.set_rest_kinetic(r.kinetic);
+    s.set_rest_strain(r.strain);
+    s.set_rest_reports(r.reports);
+  }
+  s.set_max_coupling_lag(max_coupling_lag_);
+  s.set_max_coupling_lag_t(max_coupling_lag_t_);
+  for (const auto& [limit, steps] : dt_limit_steps_) (*s.mutable_dt_limit_steps())[limit] = steps;
+  s.set_dt_min(dt_min_);
+  s.set_dt_max(dt_max_);
+  s.set_commands(summary.commands);
+  s.set_mean_command_s(schedule.mean_command_s);
+  s.set_run_id(run_id_);
+  s.set_stepping_wall_s(stepping_before_ + seconds_since(stepping_start_));
+  write_coupler_checkpoint(output_dir_, checkpoint_directory(step_), s);
+}
+
+void Coupler::restore_checkpoint(Schedule& schedule, RunSummary& summary) {
+  const auto& s = options_.restart->state;
+  schedule.dt = s.dt();
+  schedule.frame = s.frame();
+  schedule.next_output = s.next_output();
+  schedule.next_checkpoint = s.next_checkpoint();
+  schedule.mean_command_s = s.mean_command_s();
+  dt_limit_ = s.dt_limit();
+  for (int i = 0; i < 2; ++i) {
+    Side& side = sides_[i];
+    const auto& in = i == 0 ? s.solid() : s.fluid();
+    if (in.expected() != side.expected) {
+      throw RunFailure{"the checkpoint " + options_.restart->directory + (in.expected() ? " has" : " has no") + " " +
+                       side.name + " side; this run " + (side.expected ? "has one" : "has none")};
+    }
+    // The sides' Ready after a restart carries their restored state; the
+    // coupler continues with what it had from the reports at the checkpoint.
+    side.stable_dt = in.stable_dt();
+    side.stable_dt_limit = in.stable_dt_limit();
+    side.diagnostics = proto::from_proto(in.diagnostics());
+    side.compute_s = in.compute_s();
+    side.exchange_s = in.exchange_s();
+  }
+  if (energy_) {
+    energy_->restore(
+        {s.energy_e0(), s.energy_p(), s.energy_v(), s.energy_work(), s.energy_largest(), s.energy_largest_t()});
+  }
+  if (rest_) rest_->restore({s.rest_kinetic(), s.rest_strain(), s.rest_reports()});
+  max_coupling_lag_ = s.max_coupling_lag();
+  max_coupling_lag_t_ = s.max_coupling_lag_t();
+  for (const auto& [limit, steps] : s.dt_limit_steps()) dt_limit_steps_[limit] = steps;
+  dt_min_ = s.dt_min();
+  dt_max_ = s.dt_max();
+  summary.commands = s.commands();
+  stepping_before_ = s.stepping_wall_s();  // run.json's totals cover the whole run, before and after the restart
 }
 
 void Coupler::await_reports(std::uint64_t step, double t, double timeout_s) {

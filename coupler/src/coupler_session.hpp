@@ -60,6 +60,7 @@ struct Side {
   bool ready = false;
   bool stopping = false;
   std::string implementation;
+  bool can_checkpoint = false;  // Hello lists the capability "checkpoint"
   std::string log_path;
   std::unique_ptr<ChildProcess> process;
   std::thread thread;
@@ -149,6 +150,15 @@ class Coupler {
   // ------------------------------------------------------------- stepping
   double next_dt();
   void step_loop(RunSummary& summary);
+  // The step loop's own state, kept in checkpoints.
+  struct Schedule {
+    double dt = 0;
+    std::uint64_t frame = 1;
+    double next_output = 0, next_checkpoint = 0;
+    double mean_command_s = 0;
+  };
+  void save_checkpoint(const Schedule& schedule, const RunSummary& summary);
+  void restore_checkpoint(Schedule& schedule, RunSummary& summary);
   void await_reports(std::uint64_t step, double t, double timeout_s);
   std::string hung_message(double timeout_s) const;
 
@@ -185,7 +195,10 @@ class Coupler {
   Progress progress_;
   microseconds heartbeat_interval_{500000}, heartbeat_timeout_{3000000};
   Clock::time_point start_ = Clock::now(), last_housekeeping_{};
-  Clock::duration stalled_{};  // time the coupler itself did not run (housekeeping())
+  Clock::duration stalled_{};
+  Clock::time_point stepping_start_ = Clock::now();  // the step loop's start
+  double stepping_before_ =
+      0;  // s of stepping before a restart's checkpoint  // time the coupler itself did not run (housekeeping())
   std::uint64_t step_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
   std::unique_ptr<EnergyWatch> energy_;

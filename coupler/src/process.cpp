@@ -16,7 +16,7 @@
 namespace hfmpm::coupling {
 
 ChildProcess::ChildProcess(const std::string& program, const std::vector<std::string>& args,
-                           const std::string& log_path) {
+                           const std::string& log_path, bool append) {
   if (access(program.c_str(), X_OK) != 0) {
     throw std::runtime_error("cannot run '" + program + "': " + std::strerror(errno));
   }
@@ -27,7 +27,7 @@ ChildProcess::ChildProcess(const std::string& program, const std::vector<std::st
   std::vector<char*> argv;
   for (auto& s : storage) argv.push_back(s.data());
   argv.push_back(nullptr);
-  const int log = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  const int log = open(log_path.c_str(), O_WRONLY | O_CREAT | (append ? O_APPEND : O_TRUNC) | O_CLOEXEC, 0644);
   if (log < 0) throw std::runtime_error("cannot write '" + log_path + "': " + std::strerror(errno));
   const pid_t parent = getpid();
 

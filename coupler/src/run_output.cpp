@@ -11,9 +11,11 @@
 
 namespace hfmpm::coupling {
 
-History::History(const std::string& path) : out_(path) {
+History::History(const std::string& path, bool append)
+    : out_(path, std::ios::out | (append ? std::ios::app : std::ios::trunc)) {
   if (!out_) throw std::runtime_error("cannot write " + path);
   out_ << std::setprecision(10);
+  if (append) return;
   // The first nine columns are the ones every hfmpm history has (docs/architecture.md, "history.csv").
   out_ << "time_s,step,crack_length_m,mouth_opening_m,inlet_pressure_pa,injected_volume_m2,fluid_volume_m2,"
           "kinetic_energy_j,wall_s,dt_s,crack_face_load_n_per_m,front_position_m,crack_particles,fluid_particles,"
@@ -68,7 +70,9 @@ void Manifest::save() const {
   std::rename(tmp.c_str(), path_.c_str());
 }
 
-void Log::open(const std::string& path) { file_.open(path, std::ios::trunc); }
+void Log::open_file(const std::string& path, bool append) {
+  file_.open(path, std::ios::out | (append ? std::ios::app : std::ios::trunc));
+}
 
 void Log::operator()(const std::string& line) {
   if (echo_) std::cerr << "hfmpm: " << line << "\n";

@@ -14,7 +14,8 @@ namespace hfmpm::coupling {
 
 class History {
  public:
-  explicit History(const std::string& path);
+  // append: continue an existing history (a restart; truncate_history first), without a new header.
+  explicit History(const std::string& path, bool append = false);
   void write(double t, std::uint64_t step, double dt, const SideDiagnostics& solid, const SideDiagnostics& fluid,
              double wall_s);
 
@@ -39,15 +40,17 @@ class Manifest {
 // Log lines to stderr and to the run's coupler.log.
 class Log {
  public:
-  void open(const std::string& path, bool echo) {
-    open(path);
+  // append: continue the log of the run a restart continues.
+  void open(const std::string& path, bool echo, bool append = false) {
+    open_file(path, append);
     echo_ = echo;
   }
-  void open(const std::string& path);
+  void open(const std::string& path) { open_file(path, false); }
   void operator()(const std::string& line);
   void file_only(const std::string& line);
 
  private:
+  void open_file(const std::string& path, bool append);
   std::ofstream file_;
   bool echo_ = true;
 };

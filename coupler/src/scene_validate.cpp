@@ -85,6 +85,16 @@ void check_time(Checker& c, const scene::Scene& s) {
   const bool end_valid = s.time().has_end_s() && std::isfinite(end) && end > 0;
   const double upper = end_valid ? end : kInf;  // NOLINT(bugprone-narrowing-conversions): clang-tidy 14 misreads inf
   c.range("output.interval_s", s.output().interval_s(), 0, upper, false, "s, 0 for end_s / 100");
+  c.range("output.checkpoint_interval_s", s.output().checkpoint_interval_s(), 0, upper, false,
+          "s, 0 for no checkpoints");
+  if (s.output().checkpoint_interval_s() > 0 &&
+      ((s.has_solid() && s.solid().has_prescribed_crack()) || (s.has_fluid() && s.fluid().has_prescribed_pressure()))) {
+    std::ostringstream value;
+    value << s.output().checkpoint_interval_s();
+    c.bad("output.checkpoint_interval_s", value.str(),
+          "0 with a stand-in side (solid.prescribed_crack, fluid.prescribed_pressure): the stand-ins do not write "
+          "checkpoints; only the MPM sides do");
+  }
 }
 
 void check_coupling(Checker& c, const scene::Coupling& k) {

@@ -7,7 +7,8 @@
 #include <set>
 
 #include "hfmpm/fluid/mpm/solver.hpp"
-#include "hfmpm/output/frame_writer.hpp"
+#include "hfmpm/output/checkpoint_file.hpp"
+#include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
 
 namespace hfmpm::fluid {
@@ -28,10 +29,43 @@ class MpmFluidSide final : public coupling::SideModel {
     listed_.insert(f.crack_ids().begin(), f.crack_ids().end());
     if (f.has_initial_fill()) fill_ = f.initial_fill();
     max_substeps_ = std::max<std::uint32_t>(1, f.max_substeps());
-    if (scene.output().hdf5()) {
-      writer_.emplace(output_dir + "/fluid.h5", "hfmpm fluid: " + scene.name());
-      writer_->attribute("units", "SI; 2D quantities per unit thickness");
-    }
+    frames_.setup(scene.output().hdf5() ? output_dir + "/fluid.h5" : std::string(), "hfmpm fluid: " + scene.name());
+  }
+
+  bool can_checkpoint() const override { return true; }
+  void will_restart() override { frames_.will_restart(); }
+  void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::write_checkpoint(path, stamp, [&](StateWriter& out) {
+      std::vector<std::uint32_t> ids;
+      for (const auto& c : cracks_) {
+        ids.push_back(c.id);
+        PrefixedWriter solver(out, "fluid" + std::to_string(c.id) + ".");
+        c.solver.save(solver);
+      }
+      out.put("side.cracks", ids);
+      out.put("side.received", static_cast<int>(received_));
+      out.put("side.substeps", substeps_);
+      out.put("side.steps", steps_);
+      frames_.save(out);
+    });
+  }
+  void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::read_checkpoint(path, stamp, [&](const StateReader& in) {
+      std::vector<std::uint32_t> ids;
+      in.get("side.cracks", ids);
+      std::vector<FluidCrack> restored(ids.size(), FluidCrack{0, mpm::FluidSolver(config_)});
+      for (std::size_t i = 0; i < ids.size(); ++i) {
+        restored[i].id = ids[i];
+        restored[i].solver.load(PrefixedReader(in, "fluid" + std::to_string(ids[i]) + "."));
+      }
+      cracks_ = std::move(restored);
+      int received = 0;
+      in.get("side.received", received);
+      received_ = received != 0;
+      in.get("side.substeps", substeps_);
+      in.get("side.steps", steps_);
+      frames_.resume(in);
+    });
   }
 
   // The coupled step may hold max_substeps fluid steps (the fluid subcycles).
@@ -132,26 +166,27 @@ class MpmFluidSide final : public coupling::SideModel {
   }
 
   void write_output(std::uint64_t /*frame*/, double t) override {
-    if (!writer_) return;
-    writer_->begin_frame(t, steps_of_first());
+    output::FrameWriter* writer = frames_.writer();
+    if (!writer) return;
+    writer->begin_frame(t, steps_of_first());
     for (const auto& c : cracks_) {
       const auto& s = c.solver;
       const auto& p = s.particles();
       const std::string id = std::to_string(c.id);
-      writer_->points("fluid" + id, s.particle_positions());
-      writer_->scalar("fluid" + id, "arc_length", p.s);
-      writer_->scalar("fluid" + id, "length", p.length);
-      writer_->scalar("fluid" + id, "width", p.width);
-      writer_->scalar("fluid" + id, "pressure", p.pressure);
-      writer_->scalar("fluid" + id, "velocity", p.velocity);
-      writer_->scalar("fluid" + id, "mass", p.mass);
+      writer->points("fluid" + id, s.particle_positions());
+      writer->scalar("fluid" + id, "arc_length", p.s);
+      writer->scalar("fluid" + id, "length", p.length);
+      writer->scalar("fluid" + id, "width", p.width);
+      writer->scalar("fluid" + id, "pressure", p.pressure);
+      writer->scalar("fluid" + id, "velocity", p.velocity);
+      writer->scalar("fluid" + id, "mass", p.mass);
       const auto& g = s.grid();
-      writer_->points("nodes" + id, g.position());
-      writer_->scalar("nodes" + id, "arc_length", g.arc());
-      writer_->scalar("nodes" + id, "width", g.width());
-      writer_->scalar("nodes" + id, "pressure", s.nodal_pressure());
+      writer->points("nodes" + id, g.position());
+      writer->scalar("nodes" + id, "arc_length", g.arc());
+      writer->scalar("nodes" + id, "width", g.width());
+      writer->scalar("nodes" + id, "pressure", s.nodal_pressure());
     }
-    writer_->end_frame();
+    writer->end_frame();
   }
 
  private:
@@ -184,7 +219,7 @@ class MpmFluidSide final : public coupling::SideModel {
   std::vector<FluidCrack> cracks_;
   bool received_ = false;
   std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
-  std::optional<output::FrameWriter> writer_;
+  output::SideFrames frames_;               // the frame file (solid.h5 / fluid.h5) across restarts
 };
 
 }  // namespace

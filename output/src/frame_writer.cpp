@@ -54,6 +54,8 @@ struct PendingFrame {
 
 struct FrameWriter::Impl {
   Impl(const std::string& h5, const std::string& xmf) : h5_path(h5), xdmf_path(xmf), file(h5) {}
+  Impl(const std::string& h5, const std::string& xmf, h5::File::OpenExisting open)
+      : h5_path(h5), xdmf_path(xmf), file(h5, open) {}
 
   std::string h5_path, xdmf_path, h5_name;
   h5::File file;
@@ -163,6 +165,86 @@ FrameWriter::FrameWriter(const std::string& h5_path, const std::string& title) {
   impl_->file.create_group("/frames");
   impl_->file.set_attribute("/frames", "frame_count", std::uint64_t{0});
   attribute("title", title);  // also flushes
+}
+
+void FrameWriter::save(StateWriter& out) const {
+  const Impl& m = *impl_;
+  if (m.frame) throw std::logic_error("FrameWriter::save: a frame is open (call end_frame first)");
+  out.put("next_index", m.next_index);
+  out.put("written", m.written);
+  out.put("has_last_time", m.last_time ? 1 : 0);
+  out.put("last_time", m.last_time.value_or(0.0));
+  // Strings as one blob each, with their lengths.
+  auto strings = [&](const std::string& name, const std::vector<std::string>& list) {
+    std::string blob;
+    std::vector<std::uint64_t> lengths;
+    for (const auto& text : list) {
+      blob += text;
+      lengths.push_back(text.size());
+    }
+    out.text(name + ".text", blob);
+    out.put(name + ".lengths", lengths);
+  };
+  std::vector<std::string> information;
+  for (const auto& [key, value] : m.information) {
+    information.push_back(key);
+    information.push_back(value);
+  }
+  strings("information", information);
+  std::vector<std::string> sets;
+  for (const auto& c : m.collections) sets.push_back(c.set);
+  strings("sets", sets);
+  for (std::size_t i = 0; i < m.collections.size(); ++i) strings("grids" + std::to_string(i), m.collections[i].grids);
+}
+
+namespace {
+std::vector<std::string> saved_strings(const StateReader& in, const std::string& name) {
+  const std::string blob = in.text(name + ".text");
+  std::vector<std::uint64_t> lengths;
+  in.get(name + ".lengths", lengths);
+  std::vector<std::string> list;
+  std::size_t at = 0;
+  for (auto n : lengths) {
+    if (n > blob.size() - at) throw std::runtime_error("FrameWriter: the saved " + name + " are cut short");
+    list.push_back(blob.substr(at, n));
+    at += n;
+  }
+  return list;
+}
+}  // namespace
+
+FrameWriter::FrameWriter(const std::string& h5_path, const StateReader& saved) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  if (!fs::is_regular_file(h5_path, error)) {
+    throw std::runtime_error("FrameWriter: cannot continue " + h5_path + ": the file is not there");
+  }
+  const std::string xmf = fs::path(h5_path).replace_extension(".xmf").string();
+  impl_ = std::make_unique<Impl>(h5_path, xmf, h5::File::OpenExisting{});
+  Impl& m = *impl_;
+  m.h5_name = fs::path(h5_path).filename().string();
+  saved.get("next_index", m.next_index);
+  saved.get("written", m.written);
+  int has_last = 0;
+  saved.get("has_last_time", has_last);
+  double last = 0;
+  saved.get("last_time", last);
+  if (has_last) m.last_time = last;
+  const auto information = saved_strings(saved, "information");
+  for (std::size_t i = 0; i + 1 < information.size(); i += 2)
+    m.information.emplace_back(information[i], information[i + 1]);
+  const auto sets = saved_strings(saved, "sets");
+  for (std::size_t i = 0; i < sets.size(); ++i) {
+    m.collections.push_back(xdmf::Collection{sets[i], saved_strings(saved, "grids" + std::to_string(i))});
+  }
+  // Frames numbered from next_index on were written after the saved state: they go.
+  for (const std::string& name : m.file.children("/frames")) {
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (std::stoull(name) >= m.next_index) m.file.remove("/frames/" + name);
+  }
+  m.file.set_attribute("/frames", "frame_count", static_cast<std::uint64_t>(m.written));
+  m.file.flush();
+  m.write_xdmf();
 }
 
 FrameWriter::~FrameWriter() = default;

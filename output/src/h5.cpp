@@ -84,6 +84,45 @@ File::File(const std::string& path) : path_(path) {
   if (!access.close()) fail(path_, "closing the file-access property list of", "");
 }
 
+File::File(const std::string& path, OpenExisting) : path_(path) {
+  Quiet quiet;
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!access.valid()) fail(path_, "creating a file-access property list for", "");
+#if (H5_VERSION_GE(1, 10, 7) && !H5_VERSION_GE(1, 12, 0)) || H5_VERSION_GE(1, 12, 1)
+  if (H5Pset_file_locking(access.get(), false, true) < 0) fail(path_, "disabling file locking for", "");
+#endif
+  id_ = H5Fopen(path_.c_str(), H5F_ACC_RDWR, access.get());
+  if (id_ < 0) fail(path_, "opening for writing (H5Fopen)", "");
+  if (!access.close()) fail(path_, "closing the file-access property list of", "");
+}
+
+namespace {
+herr_t collect_name(hid_t /*group*/, const char* name, const H5L_info_t* /*info*/, void* data) {
+  static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+  return 0;
+}
+}  // namespace
+
+std::vector<std::string> File::children(const std::string& group) {
+  Quiet quiet;
+  std::vector<std::string> names;
+  Handle g(H5Gopen2(id_, group.c_str(), default_plist()), H5Gclose);
+  if (!g.valid()) fail(path_, "opening group", group);
+  if (H5Literate(g.get(), H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_name, &names) < 0) {
+    fail(path_, "listing group", group);
+  }
+  return names;
+}
+
+void File::remove(const std::string& object) {
+  Quiet quiet;
+  if (H5Ldelete(id_, object.c_str(), default_plist()) < 0) fail(path_, "removing", object);
+}
+
+void File::write_u8(const std::string& object, const std::vector<hsize_t>& dims, const std::uint8_t* data) {
+  write_dataset(object, dims, H5T_STD_U8LE, H5T_NATIVE_UINT8, data);
+}
+
 File::~File() {
   if (id_ >= 0) {
     Quiet quiet;
@@ -104,6 +143,10 @@ void File::write_f64(const std::string& object, const std::vector<hsize_t>& dims
 
 void File::write_i32(const std::string& object, const std::vector<hsize_t>& dims, const std::int32_t* data) {
   write_dataset(object, dims, H5T_STD_I32LE, H5T_NATIVE_INT32, data);
+}
+
+void File::write_u64(const std::string& object, const std::vector<hsize_t>& dims, const std::uint64_t* data) {
+  write_dataset(object, dims, H5T_STD_U64LE, H5T_NATIVE_UINT64, data);
 }
 
 void File::write_dataset(const std::string& object, const std::vector<hsize_t>& dims, hid_t file_type, hid_t mem_type,
@@ -172,6 +215,87 @@ void File::write_attribute(const std::string& object, const std::string& name, h
 void File::flush() {
   Quiet quiet;
   if (H5Fflush(id_, H5F_SCOPE_GLOBAL) < 0) fail(path_, "flushing (H5Fflush)", "");
+}
+
+ReadFile::ReadFile(const std::string& path) : path_(path) {
+  Quiet quiet;
+  Handle access(H5Pcreate(H5P_FILE_ACCESS), H5Pclose);
+  if (!access.valid()) fail(path_, "creating a file-access property list for", "");
+#if (H5_VERSION_GE(1, 10, 7) && !H5_VERSION_GE(1, 12, 0)) || H5_VERSION_GE(1, 12, 1)
+  if (H5Pset_file_locking(access.get(), false, true) < 0) fail(path_, "disabling file locking for", "");
+#endif
+  id_ = H5Fopen(path_.c_str(), H5F_ACC_RDONLY, access.get());
+  if (id_ < 0) fail(path_, "opening (H5Fopen)", "");
+}
+
+ReadFile::~ReadFile() {
+  if (id_ >= 0) {
+    Quiet quiet;
+    H5Fclose(id_);
+  }
+}
+
+bool ReadFile::has(const std::string& object) const {
+  Quiet quiet;
+  return H5Lexists(id_, object.c_str(), default_plist()) > 0;
+}
+
+std::size_t ReadFile::elements(const std::string& object) const {
+  Quiet quiet;
+  if (!has(object)) throw std::runtime_error("checkpoint " + path_ + " has no array " + object);
+  Handle dataset(H5Dopen2(id_, object.c_str(), default_plist()), H5Dclose);
+  if (!dataset.valid()) fail(path_, "opening dataset", object);
+  Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  if (!space.valid()) fail(path_, "reading the dataspace of dataset", object);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  if (n < 0) fail(path_, "counting the elements of dataset", object);
+  return static_cast<std::size_t>(n);
+}
+
+void ReadFile::read(const std::string& object, hid_t mem_type, hid_t want_class, void* data, std::size_t n) const {
+  Quiet quiet;
+  Handle dataset(H5Dopen2(id_, object.c_str(), default_plist()), H5Dclose);
+  if (!dataset.valid()) fail(path_, "opening dataset", object);
+  Handle type(H5Dget_type(dataset.get()), H5Tclose);
+  if (!type.valid()) fail(path_, "reading the type of dataset", object);
+  if (H5Tget_class(type.get()) != static_cast<H5T_class_t>(want_class)) {
+    throw std::runtime_error("checkpoint " + path_ + ": array " + object + " has another type than expected");
+  }
+  if (n > 0 && H5Dread(dataset.get(), mem_type, all_space(), all_space(), default_plist(), data) < 0) {
+    fail(path_, "reading dataset", object);
+  }
+}
+
+std::vector<double> ReadFile::read_f64(const std::string& object) const {
+  std::vector<double> values(elements(object));
+  read(object, H5T_NATIVE_DOUBLE, H5T_FLOAT, values.data(), values.size());
+  return values;
+}
+
+std::vector<std::uint64_t> ReadFile::read_u64(const std::string& object) const {
+  std::vector<std::uint64_t> values(elements(object));
+  read(object, H5T_NATIVE_UINT64, H5T_INTEGER, values.data(), values.size());
+  return values;
+}
+
+std::string ReadFile::read_text(const std::string& object) const {
+  std::string bytes(elements(object), '\0');
+  read(object, H5T_NATIVE_UINT8, H5T_INTEGER, bytes.data(), bytes.size());
+  return bytes;
+}
+
+std::string ReadFile::root_attribute(const std::string& name) const {
+  Quiet quiet;
+  if (H5Aexists(id_, name.c_str()) <= 0) return {};
+  Handle attribute(H5Aopen(id_, name.c_str(), default_plist()), H5Aclose);
+  if (!attribute.valid()) fail(path_, "opening attribute", name);
+  Handle type(H5Aget_type(attribute.get()), H5Tclose);
+  if (!type.valid() || H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0) return {};
+  const std::size_t size = H5Tget_size(type.get());
+  std::string value(size, '\0');
+  if (size > 0 && H5Aread(attribute.get(), type.get(), value.data()) < 0) fail(path_, "reading attribute", name);
+  value.resize(value.find('\0') == std::string::npos ? size : value.find('\0'));
+  return value;
 }
 
 }  // namespace hfmpm::output::h5

@@ -15,6 +15,9 @@ class File {
  public:
   // Creates the file, truncating an existing one.
   explicit File(const std::string& path);
+  // Opens an existing file for writing (FrameWriter's resume after a restart).
+  struct OpenExisting {};
+  File(const std::string& path, OpenExisting);
   ~File();
   File(const File&) = delete;
   File& operator=(const File&) = delete;
@@ -23,7 +26,12 @@ class File {
   // Datasets of the given dimensions (row-major); data may be null when a dimension is 0.
   void write_f64(const std::string& object, const std::vector<hsize_t>& dims, const double* data);
   void write_i32(const std::string& object, const std::vector<hsize_t>& dims, const std::int32_t* data);
-  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
+  void write_u64(const std::string& object, const std::vector<hsize_t>& dims, const std::uint64_t* data);
+  void write_u8(const std::string& object, const std::vector<hsize_t>& dims, const std::uint8_t* data);
+  // Names of the links in a group, and removing one (with what hangs below it).
+  std::vector<std::string> children(const std::string& group);
+  void remove(const std::string&
+                  object);  // Scalar attributes on a group or dataset; an existing attribute of that name is replaced.
   void set_attribute(const std::string& object, const std::string& name, double value);
   void set_attribute(const std::string& object, const std::string& name, std::uint64_t value);
   void set_attribute(const std::string& object, const std::string& name, const std::string& value);
@@ -37,6 +45,30 @@ class File {
   void write_attribute(const std::string& object, const std::string& name, hid_t file_type, hid_t mem_type,
                        const void* data);
 
+  std::string path_;
+  hid_t id_ = -1;
+};
+
+// A file opened read-only (checkpoints): whole datasets and string attributes of the root group.
+class ReadFile {
+ public:
+  explicit ReadFile(const std::string& path);
+  ~ReadFile();
+  ReadFile(const ReadFile&) = delete;
+  ReadFile& operator=(const ReadFile&) = delete;
+
+  bool has(const std::string& object) const;
+  // The whole dataset, converted by HDF5 to the memory type; throws if it is missing.
+  std::vector<double> read_f64(const std::string& object) const;
+  std::vector<std::uint64_t> read_u64(const std::string& object) const;
+  std::string read_text(const std::string& object) const;  // a uint8 dataset as bytes
+  // A string attribute of the root group; empty if there is none.
+  std::string root_attribute(const std::string& name) const;
+  const std::string& path() const { return path_; }
+
+ private:
+  void read(const std::string& object, hid_t mem_type, hid_t want_class, void* data, std::size_t n) const;
+  std::size_t elements(const std::string& object) const;
   std::string path_;
   hid_t id_ = -1;
 };

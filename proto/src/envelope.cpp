@@ -1,7 +1,11 @@
 #include "hfmpm/proto/envelope.hpp"
 
 #include <google/protobuf/descriptor.h>
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <google/protobuf/unknown_field_set.h>
+
+#include <cstdio>
 
 #include <vector>
 
@@ -68,6 +72,24 @@ std::string_view role_name(protocol::Role role) {
     default:
       return "unspecified";
   }
+}
+
+std::string scene_hash(const scene::Scene& scene) {
+  std::string bytes;
+  {
+    google::protobuf::io::StringOutputStream stream(&bytes);
+    google::protobuf::io::CodedOutputStream coded(&stream);
+    coded.SetSerializationDeterministic(true);
+    if (!scene.SerializeToCodedStream(&coded)) throw std::runtime_error("cannot serialize the scene to hash it");
+  }
+  std::uint64_t hash = 14695981039346656037ull;
+  for (unsigned char c : bytes) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  char text[17] = {};
+  std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash));
+  return text;
 }
 
 }  // namespace hfmpm::proto

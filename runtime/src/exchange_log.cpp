@@ -2,13 +2,40 @@
 
 #include <iomanip>
 #include <stdexcept>
+#include <string>
 
 namespace hfmpm::coupling {
 
-ExchangeLog::ExchangeLog(const std::string& directory, const std::string& role)
-    : out_(directory + "/" + role + "_received.csv") {
-  if (!out_) throw std::runtime_error("cannot write " + directory + "/" + role + "_received.csv");
+namespace {
+
+// The log's header and its rows of steps up to `step` (the rest, and a row cut short, go).
+std::string kept_rows(const std::string& path, std::uint64_t step) {
+  std::ifstream in(path);
+  std::string line, kept;
+  if (std::getline(in, line)) kept = line + "\n";
+  while (std::getline(in, line)) {
+    const auto comma = line.find(',');
+    if (comma == 0 || comma == std::string::npos || line.find_first_not_of("0123456789") != comma) break;
+    if (std::stoull(line.substr(0, comma)) > step) break;
+    kept += line + "\n";
+  }
+  return kept;
+}
+
+}  // namespace
+
+ExchangeLog::ExchangeLog(const std::string& directory, const std::string& role, std::int64_t continue_after) {
+  const std::string path = directory + "/" + role + "_received.csv";
+  if (continue_after >= 0) {
+    const std::string kept = kept_rows(path, static_cast<std::uint64_t>(continue_after));
+    out_.open(path, std::ios::out | std::ios::trunc);
+    out_ << kept;
+  } else {
+    out_.open(path, std::ios::out | std::ios::trunc);
+  }
+  if (!out_) throw std::runtime_error("cannot write " + path);
   out_ << std::setprecision(17);
+  if (continue_after >= 0 && out_.tellp() > 0) return;  // the header is there
   if (role == "fluid") {
     out_ << "step,t_s,crack_id,id,x_m,y_m,nx,ny,width_m,tip,grew\n";
   } else {

@@ -3,6 +3,7 @@
 // that crossed the data plane.
 #pragma once
 
+#include <cstdint>
 #include <fstream>
 #include <string>
 
@@ -12,7 +13,9 @@ namespace hfmpm::coupling {
 
 class ExchangeLog {
  public:
-  ExchangeLog(const std::string& directory, const std::string& role);
+  // continue_after: a restart from the checkpoint of that step keeps the log's rows up to
+  // it and appends (rows a killed run wrote after the checkpoint go); -1: a new log.
+  ExchangeLog(const std::string& directory, const std::string& role, std::int64_t continue_after = -1);
   void write(const protocol::DataFrame& frame);
 
  private:

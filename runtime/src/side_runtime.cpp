@@ -20,6 +20,7 @@
 #include "hfmpm/proto/convert.hpp"
 #include "hfmpm/runtime/coupling_scheme.hpp"
 #include "hfmpm/runtime/zmq_transport.hpp"
+#include "side_checkpoint.hpp"
 #include "side_checks.hpp"
 
 namespace hfmpm::coupling {
@@ -108,6 +109,7 @@ class SideRuntime {
     hello->set_implementation(options_.implementation);
     hello->set_implementation_version(options_.implementation_version);
     for (const auto& c : options_.capabilities) hello->add_capabilities(c);
+    if (model_.can_checkpoint()) hello->add_capabilities(std::string(kCheckpointCapability));
     hello->set_host(host_name());
     hello->set_pid(getpid());
     control_->send(hello_envelope);
@@ -158,9 +160,24 @@ class SideRuntime {
     const std::string& chosen = options_.output_dir.empty() ? welcome_.output_dir() : options_.output_dir;
     const std::string output_dir = chosen.empty() ? std::string(".") : chosen;
     std::filesystem::create_directories(output_dir);
+    const bool restart = welcome_.has_restart();
+    if (restart) model_.will_restart();
     model_.setup(scene, output_dir);
     set_up_ = true;
-    if (scene.output().exchange_log()) log_ = std::make_unique<ExchangeLog>(output_dir, role_);
+    output_dir_ = output_dir;
+    if (restart) {
+      // The state after the checkpoint's step, with what each side last
+      // received from the other: no step-0 exchange.
+      const auto& r = welcome_.restart();
+      step_ = r.step();
+      t_ = r.t();
+      heartbeat_step_ = step_;
+      model_.load_checkpoint(checkpoint_path(output_dir_, r.directory(), role_), stamp(r.step(), r.t()));
+    }
+    if (scene.output().exchange_log()) {
+      log_ = std::make_unique<ExchangeLog>(output_dir, role_,
+                                           restart ? static_cast<std::int64_t>(welcome_.restart().step()) : -1);
+    }
 
     heartbeat_->set_interval(scene.coupling().heartbeat_interval_s());
     last_from_coupler_ = Clock::now();
@@ -197,8 +214,9 @@ class SideRuntime {
       } else {
         data_ = transport_->connect_data(welcome_.data_plane().endpoint(), limit, curve);
       }
-      // Initial exchange (step 0), in the scheme's order.
-      for (const auto& action : scheme_->initial_exchange(options_.role)) {
+      // Initial exchange (step 0), in the scheme's order; none on a restart.
+      for (const auto& action :
+           restart ? std::vector<CouplingScheme::Action>{} : scheme_->initial_exchange(options_.role)) {
         if (action.kind == CouplingScheme::Action::Publish) {
           publish();
         } else {
@@ -254,6 +272,10 @@ class SideRuntime {
     }
   }
 
+  CheckpointStamp stamp(std::uint64_t step, double t) const {
+    return checkpoint_stamp(options_, role_, welcome_.scene(), step, t);
+  }
+
   void check_command(const protocol::StepCommand& command) const {
     check_step_command(command, step_, t_, scheme_->exchange_interval());
   }
@@ -290,6 +312,10 @@ class SideRuntime {
     exchange_s = std::max(0.0, exchange_s - publish_compute_s_);
     publish_compute_s_ = 0;
     if (command.write_output()) model_.write_output(command.output_frame(), t_);
+    if (command.checkpoint()) {
+      const std::string path = checkpoint_path(output_dir_, command.checkpoint_directory(), role_);
+      compute_s += write_side_checkpoint(model_, path, stamp(step_, t_), role_);
+    }
 
     protocol::Envelope envelope;
     auto* report = envelope.mutable_step_report();
@@ -301,6 +327,7 @@ class SideRuntime {
     proto::to_proto(model_.diagnostics(), report->mutable_diagnostics());
     report->set_compute_s(compute_s);
     report->set_exchange_s(exchange_s);
+    report->set_checkpoint_written(command.checkpoint());
     control_->send(envelope);
   }
 
@@ -417,6 +444,7 @@ class SideRuntime {
   double publish_compute_s_ = 0;          // s in model_.publish since the last StepReport
   bool poison_next_frame_ = false;
   bool set_up_ = false;
+  std::string output_dir_;  // where the model writes (checkpoints under it)
   std::uint64_t step_ = 0;
   double t_ = 0;
 };

@@ -5,7 +5,8 @@
 #include <map>
 #include <optional>
 
-#include "hfmpm/output/frame_writer.hpp"
+#include "hfmpm/output/checkpoint_file.hpp"
+#include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
 
@@ -44,10 +45,25 @@ class MpmSolidSide final : public coupling::SideModel {
                                 ? std::optional<TimeFunction>(proto::to_time_function(crack.pressure_pa()))
                                 : std::nullopt);
     }
-    if (scene.output().hdf5()) {
-      writer_.emplace(output_dir + "/solid.h5", "hfmpm solid: " + scene.name());
-      writer_->attribute("units", "SI; 2D quantities per unit thickness");
-    }
+    frames_.setup(scene.output().hdf5() ? output_dir + "/solid.h5" : std::string(), "hfmpm solid: " + scene.name());
+  }
+  bool can_checkpoint() const override { return true; }
+  void will_restart() override { frames_.will_restart(); }
+  void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::write_checkpoint(path, stamp, [&](StateWriter& out) {
+      PrefixedWriter solver(out, "solid.");
+      solver_->save(solver);
+      out.put("side.published", published_);
+      frames_.save(out);
+    });
+  }
+  void load_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
+    output::read_checkpoint(path, stamp, [&](const StateReader& in) {
+      PrefixedReader solver(in, "solid.");
+      solver_->load(solver);
+      in.get("side.published", published_);
+      frames_.resume(in);
+    });
   }
   double stable_dt() const override { return solver_->stable_dt(); }
   std::string stable_dt_limit() const override {
@@ -114,13 +130,14 @@ class MpmSolidSide final : public coupling::SideModel {
     return d;
   }
   void write_output(std::uint64_t /*frame*/, double t) override {
-    if (!writer_) return;
+    output::FrameWriter* writer = frames_.writer();
+    if (!writer) return;
     const auto& p = solver_->particles();
-    writer_->begin_frame(t, solver_->steps());
-    writer_->points("particles", p.x);
-    writer_->vector("particles", "velocity", p.v);
-    writer_->tensor("particles", "stress", solver_->total_stresses());
-    writer_->integer("particles", "material", p.material);
+    writer->begin_frame(t, solver_->steps());
+    writer->points("particles", p.x);
+    writer->vector("particles", "velocity", p.v);
+    writer->tensor("particles", "stress", solver_->total_stresses());
+    writer->integer("particles", "material", p.material);
     for (const auto& crack : solver_->cracks()) {
       const std::string set = "crack" + std::to_string(crack.id());
       std::vector<double> width(crack.size());
@@ -129,16 +146,16 @@ class MpmSolidSide final : public coupling::SideModel {
         width[k] = crack.width(k);
         normal[k] = crack.normal(k);
       }
-      writer_->points(set, crack.plane());
-      writer_->scalar(set, "width", width);
+      writer->points(set, crack.plane());
+      writer->scalar(set, "width", width);
       {
         std::vector<double> face(crack.size());
         for (std::size_t k = 0; k < crack.size(); ++k) face[k] = crack.face_pressure(k);
-        writer_->scalar(set, "pressure", face);
+        writer->scalar(set, "pressure", face);
       }
-      writer_->vector(set, "normal", normal);
-      writer_->points(set + "_above", crack.surface(1));
-      writer_->points(set + "_below", crack.surface(-1));
+      writer->vector(set, "normal", normal);
+      writer->points(set + "_above", crack.surface(1));
+      writer->points(set + "_below", crack.surface(-1));
     }
     if (!solver_->cracks().empty()) {
       // J and K at every tip (evaluated now: without propagation J is computed only here).
@@ -154,14 +171,14 @@ class MpmSolidSide final : public coupling::SideModel {
         kink.push_back(tip.kink);
         crack_id.push_back(static_cast<std::int32_t>(tip.crack));
       }
-      writer_->points("tips", position);
-      writer_->scalar("tips", "j", j);
-      writer_->scalar("tips", "k1", k1);
-      writer_->scalar("tips", "k2", k2);
-      writer_->scalar("tips", "kink_angle", kink);
-      writer_->integer("tips", "crack", crack_id);
+      writer->points("tips", position);
+      writer->scalar("tips", "j", j);
+      writer->scalar("tips", "k1", k1);
+      writer->scalar("tips", "k2", k2);
+      writer->scalar("tips", "kink_angle", kink);
+      writer->integer("tips", "crack", crack_id);
     }
-    writer_->end_frame();
+    writer->end_frame();
   }
 
  private:
@@ -186,7 +203,7 @@ class MpmSolidSide final : public coupling::SideModel {
   std::vector<std::optional<TimeFunction>> prescribed_;
   bool implicit_ = false;               // coupling.scheme IMPLICIT: publish the faces' response
   std::vector<std::size_t> published_;  // crack sizes at the last publication (growth flag)
-  std::optional<output::FrameWriter> writer_;
+  output::SideFrames frames_;           // the frame file (solid.h5 / fluid.h5) across restarts
 };
 
 }  // namespace

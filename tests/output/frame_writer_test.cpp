@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <map>
 
 #include "frame_model.hpp"
 #include "h5_reader.hpp"
@@ -180,6 +181,57 @@ TEST(FrameWriter, CanBeMoved) {
   EXPECT_THROW(static_cast<void>(a.in_frame()), std::logic_error);  // NOLINT(bugprone-use-after-move)
   hfmpm::test::write_frame(b, frames[1]);
   EXPECT_EQ(b.frames_written(), 2u);
+}
+
+}  // namespace
+
+namespace {
+
+// A StateWriter / StateReader in memory (checkpoints go to HDF5 through hfmpm_output's
+// write_checkpoint; the writer's save/resume do not depend on that).
+class MemoryState final : public hfmpm::StateWriter, public hfmpm::StateReader {
+ public:
+  void f64(const std::string& name, const std::vector<double>& v) override { reals_[name] = v; }
+  void u64(const std::string& name, const std::vector<std::uint64_t>& v) override { ints_[name] = v; }
+  void text(const std::string& name, const std::string& bytes) override { texts_[name] = bytes; }
+  std::vector<double> f64(const std::string& name) const override { return reals_.at(name); }
+  std::vector<std::uint64_t> u64(const std::string& name) const override { return ints_.at(name); }
+  std::string text(const std::string& name) const override { return texts_.at(name); }
+
+ private:
+  std::map<std::string, std::vector<double>> reals_;
+  std::map<std::string, std::vector<std::uint64_t>> ints_;
+  std::map<std::string, std::string> texts_;
+};
+
+// A restart: the writer's state saved after frame 2, frame 3 written by a run that is then
+// killed; the resumed writer drops frame 3 and writes it again: the files hold exactly the
+// three frames, as if nothing had happened.
+TEST(FrameWriter, ResumesFromSavedStateDroppingLaterFrames) {
+  Scratch scratch("output-resume");
+  const std::string h5 = scratch.dir() + "/run.h5", xmf = scratch.dir() + "/run.xmf";
+  const auto frames = hfmpm::test::sample_frames();
+  MemoryState saved;
+  {
+    FrameWriter writer(h5, "resume");
+    writer.attribute("units", "SI");
+    hfmpm::test::write_frame(writer, frames[0]);
+    hfmpm::test::write_frame(writer, frames[1]);
+    writer.save(saved);
+    hfmpm::test::write_frame(writer, frames[2]);  // after the checkpoint: lost with the run
+  }
+  {
+    FrameWriter writer(h5, static_cast<const hfmpm::StateReader&>(saved));
+    EXPECT_EQ(writer.frames_written(), 2u);
+  }
+  hfmpm::test::verify_files(h5, xmf, first(frames, 2), {{"title", "resume"}, {"units", "SI"}});
+  {
+    FrameWriter writer(h5, static_cast<const hfmpm::StateReader&>(saved));  // again: a second restart
+    hfmpm::test::write_frame(writer, frames[2]);
+  }
+  hfmpm::test::verify_files(h5, xmf, frames, {{"title", "resume"}, {"units", "SI"}});
+  EXPECT_THROW(FrameWriter(scratch.dir() + "/missing.h5", static_cast<const hfmpm::StateReader&>(saved)),
+               std::runtime_error);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -77,6 +78,9 @@ bool hfmpm_process_alive(pid_t pid);
 // The HDF5 C API opens the file read-only and reads every dataset in it
 // (h5_check.cpp). On failure `why` says what failed.
 bool h5_readable(const std::string& path, std::string& why);
+// A digest (FNV-1a of the bytes) of every dataset, by path: two files with equal
+// maps hold the same datasets bit for bit.
+bool h5_digests(const std::string& path, std::map<std::string, std::uint64_t>& digests, std::string& why);
 
 // history.csv parses, has its header and at least one row.
 bool history_readable(const std::string& path, std::size_t& rows, std::string& why);
@@ -96,6 +100,7 @@ struct CommonOptions {
 int kill_command(int trials, const CommonOptions& options);
 int fuzz_command(std::uint64_t messages, const CommonOptions& options);
 int bad_scenes_command(const CommonOptions& options);
+int restart_command(int trials, const CommonOptions& options);
 
 // The end of a command: prints OK or PROBLEMS FOUND, removes `root` when all
 // is well (unless --keep), else says where the outputs are; the exit status.

@@ -20,6 +20,11 @@ constexpr const char* kUsage = R"(usage:
   hfmpm-reliability fuzz --messages N [--seed S] [--keep] [--verbose]
       N random and mutated messages from strangers to `hfmpm coupler --insecure-tcp`,
       then the real sides join; then a fake coupler fuzzes the sides.
+  hfmpm-reliability restart --trials N [--seed S] [--keep] [--verbose]
+      One uninterrupted kgd-viscosity-ci run with checkpoints, then N runs of it
+      (ipc, tcp, inproc in turn) SIGKILLed (the coupler, or a side) at a random
+      moment and continued with `hfmpm run --restart`: history.csv, the exchange
+      logs and every HDF5 dataset must equal the uninterrupted run's bit for bit.
   hfmpm-reliability bad-scenes [--verbose]
       `hfmpm validate` on every file in tests/data/bad_scenes/.
 exit status: 0 nothing wrong found, 1 problems found, 2 bad command line.
@@ -65,6 +70,7 @@ int main(int argc, char** argv) {
   if (command == "kill" && trials > 0) return kill_command(static_cast<int>(trials), options);
   if (command == "fuzz" && messages > 0) return fuzz_command(static_cast<std::uint64_t>(messages), options);
   if (command == "bad-scenes") return bad_scenes_command(options);
+  if (command == "restart" && trials > 0) return restart_command(static_cast<int>(trials), options);
   std::cerr << kUsage;
   return 2;
 }

@@ -47,11 +47,22 @@ void FluidSolver::set_crack(const CrackGeometry& crack) {
     // particle end keeps its place within its element as the nodes move.
     // Left out, a stiff fluid is squeezed or stretched by the crack's own
     // in-plane motion (0.2 um of a 17 mm element is 24 kPa of water).
-    std::vector<double> moved(old_arc.size());
-    std::copy_n(grid_.arc().begin(), old_arc.size(), moved.begin());
+    // A tip element that the solid lengthened by growth (its tip particle
+    // moved ahead; elastic stretching is orders of magnitude below 10%) is
+    // new crack, not stretched wall: the fluid in it moves with the node
+    // behind it.
+    const std::size_t m = old_arc.size();
+    std::vector<double> moved(m);
+    std::copy_n(grid_.arc().begin(), m, moved.begin());
+    const double tip_before = old_arc[m - 1] - old_arc[m - 2], tip_after = moved[m - 1] - moved[m - 2];
+    const bool extended = tip_after > 1.1 * tip_before;
+    auto carry = [&](double s) {
+      if (extended && s > old_arc[m - 2]) return std::min(moved[m - 2] + (s - old_arc[m - 2]), moved[m - 1]);
+      return map_arc(s, old_arc, moved);
+    };
     for (std::size_t p = 0; p < particles_.size(); ++p) {
-      const double a = map_arc(particles_.start(p), old_arc, moved);
-      const double b = map_arc(particles_.end(p), old_arc, moved);
+      const double a = carry(particles_.start(p));
+      const double b = carry(particles_.end(p));
       particles_.f11[p] *= (b - a) / particles_.length[p];
       particles_.s[p] = 0.5 * (a + b);
       particles_.length[p] = b - a;

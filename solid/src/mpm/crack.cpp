@@ -50,6 +50,12 @@ void Crack::prepend(const Vec2& position, const Vec2& reference) {
   to_front(reference_width_);
 }
 
+void Crack::move_tip(bool at_end, const Vec2& position, const Vec2& reference) {
+  const std::size_t k = at_end ? plane_.size() - 1 : 0;
+  plane_[k] = above_[k] = below_[k] = position;
+  reference_[k] = reference;
+}
+
 Vec2 Crack::normal(std::size_t k) const {
   Vec2 n = Vec2::Zero();
   if (k > 0) n += left_normal(plane_[k - 1], plane_[k]);

@@ -67,6 +67,10 @@ namespace hfmpm::solid::mpm {
 namespace {
 
 constexpr double kForever = std::numeric_limits<double>::infinity();
+// Shortest spacing of crack particles that growth creates, in cells: the
+// opening the grid gives the faces is linear within a cell, so at most two
+// independent openings per cell (docs/solid.md, "Growth").
+constexpr double kMinSegmentCells = 0.5;
 
 // 1D plateau: 1 for r <= ri, linear to 0 at ro; value and d/dr.
 struct Ramp {
@@ -508,8 +512,13 @@ int Solver::propagate() {
     }
     if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
     if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
-      const double dry = arc_length(cracks_[tip.crack].plane()).back() - cracks_[tip.crack].wetted_length();
-      if (dry > config_.fracture.max_lag_cells * h) continue;  // wait for the fluid (zero-lag closure)
+      // The front need not enter the tip segment (its faces close to nothing at
+      // the tip): the allowed lag is at least that segment.
+      const auto& plane = cracks_[tip.crack].plane();
+      const std::vector<double> arc = arc_length(plane);
+      const double dry = arc.back() - cracks_[tip.crack].wetted_length();
+      const double allowed = std::max(config_.fracture.max_lag_cells * h, arc.back() - arc[arc.size() - 2]);
+      if (dry > allowed * (1 + 1e-9)) continue;  // wait for the fluid (zero-lag closure)
     }
     const double kink = straight ? 0.0 : tip.kink;
     const double c = std::cos(kink), s = std::sin(kink);
@@ -532,7 +541,23 @@ int Solver::propagate() {
     auto& crack = cracks_[tip.crack];
     const Vec2& tip_reference = tip.at_end ? crack.reference().back() : crack.reference().front();
     const Vec2 reference = tip_reference + (Eigen::Matrix2d::Identity() - gradient) * (next - tip.position);
-    if (tip.at_end) {
+    // Straight growth (mode I by symmetry, along the crack's own direction)
+    // lengthens a tip segment shorter than kMinSegmentCells instead of adding
+    // a new one, while the result stays within half a growth step of
+    // kMinSegmentCells (the plane's own motion makes segment lengths inexact):
+    // the faces' opening is linear within a cell, so crack particles closer
+    // than half a cell give the fluid pressure nodes whose differences the
+    // solid cannot resist (docs/solid.md, "Crack particles at least half a
+    // cell apart"). The moved tip particle stands for the material point at
+    // its new place, so its reference position moves with it by the same
+    // estimate a new particle there would get.
+    const auto& plane = crack.plane();
+    const std::size_t n = plane.size();
+    const double length = tip.at_end ? (plane[n - 1] - plane[n - 2]).norm() : (plane[0] - plane[1]).norm();
+    const double grown = length + config_.fracture.growth_cells * h;
+    if (straight && grown <= (kMinSegmentCells + 0.5 * config_.fracture.growth_cells) * h) {
+      crack.move_tip(tip.at_end, next, reference);
+    } else if (tip.at_end) {
       crack.append(next, reference);
     } else {
       crack.prepend(next, reference);

@@ -14,6 +14,30 @@
 #include "hfmpm/solid/mpm/solver.hpp"
 
 namespace hfmpm::solid::mpm {
+namespace {
+
+// The one stencil loop of P2G and G2P: fn(b, a, n, w, gx, gy) for each of the
+// up to 3 x 3 nodes n = (sx.first + a, sy.first + b) on the grid where the
+// particle's weight w is nonzero, with the weight's gradient (gx, gy).
+template <class Fn>
+inline void for_stencil(const Grid& g, const Stencil1D& sx, const Stencil1D& sy, Fn&& fn) {
+  for (int b = 0; b < 3; ++b) {
+    const int j = sy.first + b;
+    if (j < 0 || j > g.ny) continue;
+    const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
+    for (int a = 0; a < 3; ++a) {
+      const int i = sx.first + a;
+      if (i < 0 || i > g.nx) continue;
+      const double w = sx.s[static_cast<std::size_t>(a)] * syb;
+      if (w == 0) continue;
+      const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
+      const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
+      fn(b, a, static_cast<std::size_t>(g.node(i, j)), w, gx, gy);
+    }
+  }
+}
+
+}  // namespace
 
 // P2G: each thread zeroes the band of grid rows its particles reach in its
 // own accumulator, scatters its particles into it, and (after all have)
@@ -92,38 +116,26 @@ void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
       if (near) sides = 1u << 15;
       mu = m * particles_.displacement[p];
     }
-    for (int b = 0; b < 3; ++b) {
-      const int j = sy.first + b;
-      if (j < 0 || j > g.ny) continue;
-      const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
-      for (int a = 0; a < 3; ++a) {
-        const int i = sx.first + a;
-        if (i < 0 || i > g.nx) continue;
-        const double w = sx.s[static_cast<std::size_t>(a)] * syb;
-        if (w == 0) continue;
-        const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
-        const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
-        const auto n = static_cast<std::size_t>(g.node(i, j));
-        std::size_t slot = n * F;
-        if constexpr (kCracks) {
-          if (near && field_of(x, g.position(static_cast<int>(n)))) {
-            ++slot;
-            sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
-          }
-        }
-        NodeAcc& f = acc[slot];
-        f.m += w * m;
-        f.px += w * mv.x();
-        f.py += w * mv.y();
-        // internal force -V sigma . grad S (s = xx, yy, xy, zz)
-        f.fx -= vol * (s[0] * gx + s[2] * gy);
-        f.fy -= vol * (s[2] * gx + s[1] * gy);
-        if constexpr (kCracks) {
-          f.ux += w * mu.x();
-          f.uy += w * mu.y();
+    for_stencil(g, sx, sy, [&](int b, int a, std::size_t n, double w, double gx, double gy) {
+      std::size_t slot = n * F;
+      if constexpr (kCracks) {
+        if (near && field_of(x, g.position(static_cast<int>(n)))) {
+          ++slot;
+          sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
         }
       }
-    }
+      NodeAcc& f = acc[slot];
+      f.m += w * m;
+      f.px += w * mv.x();
+      f.py += w * mv.y();
+      // internal force -V sigma . grad S (s = xx, yy, xy, zz)
+      f.fx -= vol * (s[0] * gx + s[2] * gy);
+      f.fy -= vol * (s[2] * gx + s[1] * gy);
+      if constexpr (kCracks) {
+        f.ux += w * mu.x();
+        f.uy += w * mu.y();
+      }
+    });
     if constexpr (kCracks) stencil_fields_[p] = sides;
   }
 }
@@ -198,27 +210,16 @@ void Solver::g2p(double dt) {
     if constexpr (kCracks) sides = stencil_fields_[p];  // the fields P2G found for its nodes
     Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
     double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
-    for (int b = 0; b < 3; ++b) {
-      const int j = sy.first + b;
-      if (j < 0 || j > g.ny) continue;
-      for (int c = 0; c < 3; ++c) {
-        const int i = sx.first + c;
-        if (i < 0 || i > g.nx) continue;
-        const double w = sx.s[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
-        if (w == 0) continue;
-        const double gx = sx.g[static_cast<std::size_t>(c)] * sy.s[static_cast<std::size_t>(b)];
-        const double gy = sx.s[static_cast<std::size_t>(c)] * sy.g[static_cast<std::size_t>(b)];
-        const auto n = static_cast<std::size_t>(g.node(i, j));
-        const int field = (sides >> (3 * b + c)) & 1;
-        const Vec2& vn = velocity_[field][n];
-        v_new += w * vn;
-        a += w * acceleration_[field][n];
-        l00 += vn.x() * gx;
-        l01 += vn.x() * gy;
-        l10 += vn.y() * gx;
-        l11 += vn.y() * gy;
-      }
-    }
+    for_stencil(g, sx, sy, [&](int b, int c, std::size_t n, double w, double gx, double gy) {
+      const int field = (sides >> (3 * b + c)) & 1;
+      const Vec2& vn = velocity_[field][n];
+      v_new += w * vn;
+      a += w * acceleration_[field][n];
+      l00 += vn.x() * gx;
+      l01 += vn.x() * gy;
+      l10 += vn.y() * gx;
+      l11 += vn.y() * gy;
+    });
     particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
     particles_.x[p] += dt * v_new;
     if constexpr (kCracks) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "hfmpm/coupling/checkpoint.hpp"
 #include "hfmpm/runtime/side_runtime.hpp"
 #include "hfmpm/runtime/transport.hpp"
 #include "hfmpm/scene.pb.h"
@@ -48,6 +49,9 @@ struct RunOptions {
   // (hfmpm keygen). insecure_tcp: plain tcp, for sides that cannot do CURVE.
   std::string keys_file;
   bool insecure_tcp = false;
+  // Continue from this checkpoint (hfmpm run --restart): output_dir must be its
+  // run directory, and the scene its scene (check_restart_scene).
+  std::shared_ptr<const RestartPoint> restart;
 };
 
 struct RunSummary {

@@ -41,6 +41,20 @@ class EnergyWatch {
   double largest_ratio() const { return largest_; }  // max KE / (W_in + p0 V0)
   double largest_ratio_time() const { return largest_t_; }
 
+  // The accumulators, for checkpoints.
+  struct State {
+    double e0 = 0, p = 0, v = 0, work = 0, largest = 0, largest_t = 0;
+  };
+  State state() const { return {e0_, p_, v_, work_, largest_, largest_t_}; }
+  void restore(const State& s) {
+    e0_ = s.e0;
+    p_ = s.p;
+    v_ = s.v;
+    work_ = s.work;
+    largest_ = s.largest;
+    largest_t_ = s.largest_t;
+  }
+
  private:
   double bound_;
   double e0_ = 0;
@@ -72,6 +86,18 @@ class RestWatch {
   double ratio() const;  // mean KE / mean strain energy over the last tenth of the run
   // The warning's text, or nullopt when the solid ends at rest.
   std::optional<std::string> warning() const;
+
+  // The accumulators, for checkpoints.
+  struct State {
+    double kinetic = 0, strain = 0;
+    int reports = 0;
+  };
+  State state() const { return {kinetic_, strain_, reports_}; }
+  void restore(const State& s) {
+    kinetic_ = s.kinetic;
+    strain_ = s.strain;
+    reports_ = s.reports;
+  }
 
  private:
   double window_start_, bound_;

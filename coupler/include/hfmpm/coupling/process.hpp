@@ -14,7 +14,9 @@ namespace hfmpm::coupling {
 class ChildProcess {
  public:
   // Starts `program` with `args`; stdout and stderr go to `log_path`.
-  ChildProcess(const std::string& program, const std::vector<std::string>& args, const std::string& log_path);
+  // append: add to log_path (a restarted run keeps the log of the run it continues) instead of truncating it.
+  ChildProcess(const std::string& program, const std::vector<std::string>& args, const std::string& log_path,
+               bool append = false);
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;

@@ -58,6 +58,7 @@
 #include <vector>
 
 #include "hfmpm/exchange.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::output {
 
@@ -66,6 +67,15 @@ class FrameWriter {
   // Creates (truncates) h5_path; the XDMF is <h5_path with extension .xmf> (see above for when it appears).
   // title is stored as the root attribute "title" and as an <Information Name="title"> in the XDMF.
   FrameWriter(const std::string& h5_path, const std::string& title);
+  // Restarts (docs/reliability.md, "Checkpoint and restart"): save() writes what the writer
+  // knows of the frames written so far (their number, times and XDMF entries); the resuming
+  // constructor opens the existing h5_path for writing, removes the frame groups written after
+  // that state was saved (by a run killed after its checkpoint), sets frame_count back and
+  // rewrites the XDMF, so that the continued run's file holds the frames an uninterrupted run
+  // would have. Throws std::runtime_error if the file is missing or unreadable. Call save()
+  // between frames only.
+  void save(StateWriter& out) const;
+  FrameWriter(const std::string& h5_path, const StateReader& saved);
   // Closes the file. A frame begun but not ended is discarded from the XDMF and from frame_count.
   ~FrameWriter();
   FrameWriter(FrameWriter&&) noexcept;

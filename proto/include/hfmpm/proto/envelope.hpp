@@ -13,6 +13,12 @@ namespace hfmpm::proto {
 
 inline constexpr std::uint32_t kProtocolVersion = protocol::CURRENT;
 inline constexpr std::uint32_t kSceneSchemaVersion = protocol::SCENE_SCHEMA_CURRENT;
+// The program's version: in Hello, and in every checkpoint (a checkpoint of another version is refused).
+inline constexpr const char* kProgramVersion = "0.1.0";
+
+// 16 hex digits: FNV-1a (64 bits) of the scene's deterministic binary serialization. Two scenes
+// with the same hash are the same scene for a restart (docs/reliability.md, "Checkpoint and restart").
+std::string scene_hash(const scene::Scene& scene);
 
 // A message that breaks the protocol: malformed, unexpected, or inconsistent.
 class ProtocolError : public std::runtime_error {

@@ -16,6 +16,7 @@
 #include "hfmpm/runtime/curve.hpp"
 #include "hfmpm/runtime/transport.hpp"
 #include "hfmpm/scene.pb.h"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::coupling {
 
@@ -24,6 +25,9 @@ class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// Listed in Hello by a side that writes checkpoints and restarts from them.
+inline constexpr const char* kCheckpointCapability = "checkpoint";
 
 // What a side's physics must provide. Called from one thread only.
 class SideModel {
@@ -42,6 +46,23 @@ class SideModel {
   virtual SideDiagnostics diagnostics() const = 0;
   virtual void write_output(std::uint64_t /*frame*/, double /*t*/) {}
   virtual void finish() {}
+  // Checkpoints (docs/reliability.md, "Checkpoint and restart"). A model that
+  // can write its whole state returns true here; the runtime then lists the
+  // capability "checkpoint" in Hello, and the coupler asks only such sides for
+  // checkpoints or a restart. save_checkpoint writes the state after the
+  // block just done to `path` atomically (write, fsync, rename), stamped with
+  // `stamp`; load_checkpoint, called after setup() instead of the step-0
+  // exchange, restores it and refuses a file whose stamp differs.
+  virtual bool can_checkpoint() const { return false; }
+  // Called before setup() when the run continues from a checkpoint (load_checkpoint
+  // follows setup): setup() must then leave the files a restart continues alone.
+  virtual void will_restart() {}
+  virtual void save_checkpoint(const std::string& /*path*/, const CheckpointStamp& /*stamp*/) {
+    throw InputError("this side cannot write checkpoints");
+  }
+  virtual void load_checkpoint(const std::string& /*path*/, const CheckpointStamp& /*stamp*/) {
+    throw InputError("this side cannot restart from a checkpoint");
+  }
 };
 
 // Test hook: make a side fail on purpose at a step ("KIND@STEP").
@@ -56,7 +77,7 @@ struct SideOptions {
   protocol::Role role = protocol::ROLE_UNSPECIFIED;
   std::string control_endpoint;  // the coupler's control socket
   std::string implementation;    // e.g. "hfmpm-prescribed-solid"
-  std::string implementation_version = "0.1.0";
+  std::string implementation_version = proto::kProgramVersion;
   std::vector<std::string> capabilities;
   std::string advertise_host;                                       // tcp: host the peer can reach this side at
   std::string output_dir;                                           // overrides the coupler's output_dir

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "hfmpm/exchange.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::fluid::mpm {
 
@@ -54,6 +55,10 @@ class CrackGrid {
   Vec2 point_at(double s) const;
   // Linear interpolation of any nodal field at s.
   double interpolate(double s, std::span<const double> values) const;
+
+  // Checkpoints: every member, bit for bit (fluid/src/mpm/checkpoint.cpp).
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
 
  private:
   std::uint32_t crack_id_ = 0;

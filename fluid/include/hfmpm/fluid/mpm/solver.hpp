@@ -67,6 +67,7 @@
 #include "hfmpm/fluid/mpm/eos.hpp"
 #include "hfmpm/fluid/mpm/particles.hpp"
 #include "hfmpm/fluid/mpm/shape.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::fluid::mpm {
 
@@ -162,6 +163,14 @@ class FluidSolver {
   double fluid_mass() const;                                                   // kg/m, sum of particle masses
   double fluid_volume() const;                                                 // m^2, sum of l w
   double kinetic_energy() const;                                               // J/m
+
+  // Checkpoints (checkpoint.cpp): everything a later step, report or output
+  // reads: the grid (the crack as last set, with the solid's response), the
+  // particles, the nodal fields, the shape table, the inlet's and outlet's
+  // accounts, time and step, the implicit interface's state and counters.
+  // load() into a solver built from the same config restores it bit for bit.
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
 
  private:
   void update_state(std::size_t p);  // w, F22, p of one particle from the crack

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "hfmpm/exchange.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::solid::mpm {
 
@@ -77,6 +78,16 @@ class Crack {
   // for cracks inside the body, which no fluid uses); it starts closed.
   void prepend(const Vec2& position);
   void prepend(const Vec2& position, const Vec2& reference);
+  // Moves the tip particle (the last one, or the first with at_end false) to
+  // `position` (growth that lengthens the tip segment instead of adding one),
+  // with its reference position (that of the material point now at the tip);
+  // it stays closed.
+  void move_tip(bool at_end, const Vec2& position, const Vec2& reference);
+
+  // Checkpoints: every member but the id and the tip flags (which the scene fixes); load()
+  // restores this crack bit for bit (solid/src/mpm/checkpoint.cpp).
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
 
  private:
   std::uint32_t id_;

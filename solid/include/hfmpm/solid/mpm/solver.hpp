@@ -22,6 +22,7 @@
 #include "hfmpm/solid/mpm/crack.hpp"
 #include "hfmpm/solid/mpm/grid.hpp"
 #include "hfmpm/solid/mpm/particles.hpp"
+#include "hfmpm/state_archive.hpp"
 
 namespace hfmpm::solid::mpm {
 
@@ -135,6 +136,14 @@ class Solver {
   double feedback_alpha() const { return feedback_alpha_; }
   // The region (later wins) and so material and in-situ stress at x; -1 if none.
   int region_at(const Vec2& x) const;
+
+  // Checkpoints (checkpoint.cpp): everything a later step reads, also between
+  // begin_step() and step() (the grid's fields with it): particles, cracks,
+  // nodal fields, time, step and contact counters, damping and growth state.
+  // load() into a Solver built from the same config restores it bit for bit;
+  // it throws std::runtime_error if the sizes do not fit that config.
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
 
  private:
   void generate_particles();

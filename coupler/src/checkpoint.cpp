@@ -1,0 +1,166 @@
+// Checkpoints, the coupler's part (see checkpoint.hpp).
+#include "hfmpm/coupling/checkpoint.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "hfmpm/proto/envelope.hpp"
+
+namespace hfmpm::coupling {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr const char* kPrefix = "step-";
+
+// Writes `bytes` to path.tmp, fsyncs it, renames it to path.
+void write_atomically(const std::string& path, const std::string& bytes) {
+  const std::string tmp = path + ".tmp";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write " + tmp);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n <= 0) {
+      ::close(fd);
+      throw std::runtime_error("cannot write " + tmp);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  const bool synced = ::fsync(fd) == 0;
+  ::close(fd);
+  if (!synced) throw std::runtime_error("cannot sync " + tmp);
+  fs::rename(tmp, path);
+}
+
+// Steps of the complete checkpoints in run_dir, ascending.
+std::vector<std::uint64_t> complete_steps(const std::string& run_dir) {
+  std::vector<std::uint64_t> steps;
+  const fs::path root = fs::path(run_dir) / "checkpoints";
+  std::error_code error;
+  if (!fs::is_directory(root, error)) return steps;
+  for (const auto& entry : fs::directory_iterator(root, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(kPrefix, 0) != 0 || !fs::exists(entry.path() / "coupler.pb", error)) continue;
+    const std::string digits = name.substr(std::char_traits<char>::length(kPrefix));
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 19) continue;
+    steps.push_back(std::stoull(digits));
+  }
+  std::sort(steps.begin(), steps.end());
+  return steps;
+}
+
+}  // namespace
+
+std::string checkpoint_directory(std::uint64_t step) {
+  char text[48] = {};
+  std::snprintf(text, sizeof(text), "checkpoints/%s%012llu", kPrefix, static_cast<unsigned long long>(step));
+  return text;
+}
+
+RestartPoint find_restart(const std::string& run_dir) {
+  std::error_code error;
+  if (!fs::is_directory(run_dir, error)) throw RestartError("--restart " + run_dir + ": no such run directory");
+  const auto steps = complete_steps(run_dir);
+  if (steps.empty()) {
+    throw RestartError("--restart " + run_dir + ": no complete checkpoint in " + run_dir +
+                       "/checkpoints (the scene needs output.checkpoint_interval_s > 0, and a checkpoint is "
+                       "complete only once both sides and the coupler have written it)");
+  }
+  RestartPoint point;
+  point.run_dir = run_dir;
+  point.directory = checkpoint_directory(steps.back());
+  const std::string path = (fs::path(run_dir) / point.directory / "coupler.pb").string();
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  if (!in || !point.state.ParseFromString(bytes.str())) {
+    throw RestartError("--restart " + run_dir + ": cannot read the checkpoint file " + path);
+  }
+  const auto& s = point.state;
+  auto refuse = [&](const std::string& what, const std::string& found, const std::string& here) {
+    throw RestartError("--restart " + run_dir + ": the checkpoint " + point.directory + " was written by " + what +
+                       " " + found + "; this is " + what + " " + here +
+                       ": it cannot continue that run (start the scene afresh)");
+  };
+  if (s.format() != kCouplerCheckpointFormat) {
+    refuse("checkpoint format", std::to_string(s.format()), std::to_string(kCouplerCheckpointFormat));
+  }
+  if (s.program_version() != proto::kProgramVersion) refuse("hfmpm", s.program_version(), proto::kProgramVersion);
+  if (s.protocol_version() != proto::kProtocolVersion) {
+    refuse("protocol version", std::to_string(s.protocol_version()), std::to_string(proto::kProtocolVersion));
+  }
+  if (s.scene_schema_version() != proto::kSceneSchemaVersion) {
+    refuse("scene schema version", std::to_string(s.scene_schema_version()),
+           std::to_string(proto::kSceneSchemaVersion));
+  }
+  if (proto::scene_hash(s.scene()) != s.scene_hash()) {
+    throw RestartError("--restart " + run_dir + ": the checkpoint " + point.directory +
+                       " is damaged (its scene does not match its scene hash)");
+  }
+  return point;
+}
+
+void check_restart_scene(const RestartPoint& point, const scene::Scene& scene) {
+  const std::string hash = proto::scene_hash(scene);
+  if (hash != point.state.scene_hash()) {
+    throw RestartError("--restart " + point.run_dir + ": the checkpoint " + point.directory +
+                       " was written for another scene (scene hash " + point.state.scene_hash() +
+                       "; the scene given, with its --set overrides, hashes to " + hash +
+                       "); give the run's own scene and overrides, or none to use the checkpoint's");
+  }
+}
+
+void write_coupler_checkpoint(const std::string& run_dir, const std::string& directory,
+                              const checkpoint::CouplerState& state) {
+  const fs::path dir = fs::path(run_dir) / directory;
+  fs::create_directories(dir);
+  std::string bytes;
+  if (!state.SerializeToString(&bytes)) throw std::runtime_error("cannot serialize the coupler's checkpoint");
+  write_atomically((dir / "coupler.pb").string(), bytes);
+  // Keep this one and the complete one before it; older ones (and directories
+  // of cut-short checkpoints before those) go.
+  const auto steps = complete_steps(run_dir);
+  if (steps.size() < 2) return;
+  const std::uint64_t keep_from = steps[steps.size() - 2];
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(fs::path(run_dir) / "checkpoints", error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(kPrefix, 0) != 0) continue;
+    const std::string digits = name.substr(std::char_traits<char>::length(kPrefix));
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 19) continue;
+    if (std::stoull(digits) < keep_from) fs::remove_all(entry.path(), error);
+  }
+}
+
+void truncate_history(const std::string& path, std::uint64_t step) {
+  std::ifstream in(path);
+  if (!in) throw RestartError("cannot read " + path + " to continue it");
+  std::string line, kept;
+  bool header = true;
+  while (std::getline(in, line)) {
+    if (header) {
+      kept += line + "\n";
+      header = false;
+      continue;
+    }
+    const auto first = line.find(',');
+    if (first == std::string::npos) break;  // a row cut short by the kill
+    const auto second = line.find(',', first + 1);
+    if (second == std::string::npos) break;
+    const std::string digits = line.substr(first + 1, second - first - 1);
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos) break;
+    if (std::stoull(digits) > step) break;
+    kept += line + "\n";
+  }
+  in.close();
+  write_atomically(path, kept);
+}
+
+}  // namespace hfmpm::coupling

@@ -1,0 +1,277 @@
+// Checkpoint and restart (docs/reliability.md, "Checkpoint and restart"): a
+// coupled MPM run killed with SIGKILL after a checkpoint and continued with
+// `hfmpm run --restart DIR` ends with the uninterrupted run's history,
+// exchange data and HDF5 frames, bit for bit; a checkpoint of another scene
+// or another version is refused, naming the problem.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <thread>
+
+#include "coupled_support.hpp"
+#include "h5_reader.hpp"
+#include "hfmpm/checkpoint.pb.h"
+
+namespace hfmpm::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// kgd-viscosity-ci to 0.4 s: frames every 0.05 s, checkpoints at 0.15 and 0.3
+// s (about 700 coupled steps of the MPM solid and fluid, 3 s on 2 cores), the
+// data crossing the data plane logged with 17 digits.
+const std::vector<std::string> kSets{
+    "--set", "time.end_s=0.4",          "--set", "output.interval_s=0.05", "--set", "output.checkpoint_interval_s=0.15",
+    "--set", "output.exchange_log=true"};
+
+std::vector<std::string> run_args(const std::string& out) {
+  std::vector<std::string> argv{bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"),
+                                "--out",      out,   "--quiet"};
+  argv.insert(argv.end(), kSets.begin(), kSets.end());
+  return argv;
+}
+
+// Steps of the complete checkpoints (those with the coupler's file).
+std::vector<std::uint64_t> complete_checkpoints(const std::string& out) {
+  std::vector<std::uint64_t> steps;
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(out + "/checkpoints", error)) {
+    if (fs::exists(entry.path() / "coupler.pb"))
+      steps.push_back(std::stoull(entry.path().filename().string().substr(5)));
+  }
+  std::sort(steps.begin(), steps.end());
+  return steps;
+}
+
+std::uint64_t last_history_step(const std::string& out) {
+  std::ifstream in(out + "/history.csv");
+  std::string line, last;
+  while (std::getline(in, line)) last = line;
+  const auto comma = last.find(',');
+  if (comma == std::string::npos) return 0;
+  try {
+    return std::stoull(last.substr(comma + 1));
+  } catch (const std::exception&) {
+    return 0;  // the header, or a row being written
+  }
+}
+
+// The rows of an exchange log (17 significant digits) after `step`.
+std::vector<std::string> exchange_rows_after(const std::string& path, std::uint64_t step) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> rows;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    if (std::stoull(line.substr(0, line.find(','))) > step) rows.push_back(line);
+  }
+  return rows;
+}
+
+// Every frame of two frame files: the same groups, attributes and datasets, bit for bit.
+void expect_same_frames(const std::string& a_path, const std::string& b_path, std::size_t& datasets) {
+  const H5Reader a(a_path), b(b_path);
+  ASSERT_EQ(a.children("/frames"), b.children("/frames")) << b_path;
+  EXPECT_EQ(a.attribute_u64("/frames", "frame_count"), b.attribute_u64("/frames", "frame_count"));
+  for (const auto& frame : a.children("/frames")) {
+    const std::string group = "/frames/" + frame;
+    const double ta = a.attribute_f64(group, "time_s"), tb = b.attribute_f64(group, "time_s");
+    EXPECT_EQ(std::memcmp(&ta, &tb, sizeof ta), 0) << group;
+    EXPECT_EQ(a.attribute_u64(group, "step"), b.attribute_u64(group, "step")) << group;
+    ASSERT_EQ(a.children(group), b.children(group)) << group;
+    for (const auto& set : a.children(group)) {
+      ASSERT_EQ(a.children(group + "/" + set), b.children(group + "/" + set));
+      for (const auto& name : a.children(group + "/" + set)) {
+        const std::string d = group + "/" + set + "/" + name;
+        ++datasets;
+        if (a.is_f64(d)) {
+          const auto x = a.f64(d), y = b.f64(d);
+          ASSERT_EQ(x.size(), y.size()) << d;
+          EXPECT_EQ(std::memcmp(x.data(), y.data(), x.size() * sizeof(double)), 0) << b_path << " " << d;
+        } else {
+          EXPECT_EQ(a.i32(d), b.i32(d)) << b_path << " " << d;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(read_file(fs::path(a_path).replace_extension(".xmf").string()),
+            read_file(fs::path(b_path).replace_extension(".xmf").string()));
+}
+
+TEST(Restart, AfterKillNineEqualsTheUninterruptedRun) {
+  const auto dir = scratch_dir("restart");
+  const std::string a = dir + "/a", b = dir + "/b";
+  const auto whole = run(run_args(a), 120);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  ASSERT_EQ(complete_checkpoints(a).size(), 2u) << "checkpoints at 0.15 and 0.3 s";
+
+  // The same run, killed with SIGKILL once it has written a history row past its first checkpoint.
+  std::uint64_t checkpoint = 0;
+  {
+    Process coupler(run_args(b));
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < deadline) {
+      const auto done = complete_checkpoints(b);
+      if (!done.empty() && last_history_step(b) > done.back()) {
+        checkpoint = done.back();
+        break;
+      }
+      ASSERT_TRUE(coupler.running()) << "the run ended before it could be killed: " << coupler.err();
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    ASSERT_GT(checkpoint, 0u) << "no checkpoint within 60 s";
+    ASSERT_EQ(kill(coupler.pid(), SIGKILL), 0);
+    ASSERT_TRUE(coupler.wait(10));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the sides die with it (parent-death signal)
+  ASSERT_GT(last_history_step(b), checkpoint) << "the killed run's history has rows past its checkpoint";
+  if (complete_checkpoints(b).back() != checkpoint) checkpoint = complete_checkpoints(b).back();
+
+  const auto restarted = run({bin("hfmpm"), "run", "--restart", b, "--quiet"}, 120);
+  ASSERT_EQ(restarted.exit_code, 0) << restarted.err;
+
+  // history.csv: the same rows (none twice, none missing) and values, but the wall clock.
+  expect_same_history(read_csv(a + "/history.csv"), read_csv(b + "/history.csv"));
+  // The data that crossed the data plane, 17 digits: after the checkpoint, and the whole log
+  // (the restart keeps the rows up to the checkpoint and drops the killed run's later ones).
+  for (const std::string role : {"solid", "fluid"}) {
+    const auto x = exchange_rows_after(a + "/" + role + "_received.csv", checkpoint);
+    const auto y = exchange_rows_after(b + "/" + role + "_received.csv", checkpoint);
+    EXPECT_GT(x.size(), 100u);
+    EXPECT_EQ(x, y) << role << "_received.csv after step " << checkpoint;
+    EXPECT_EQ(read_file(a + "/" + role + "_received.csv"), read_file(b + "/" + role + "_received.csv")) << role;
+  }
+  // The logs go on: the first run's lines are kept.
+  const std::string log = read_file(b + "/coupler.log");
+  EXPECT_NE(log.find("checkpoint checkpoints/step-"), std::string::npos) << log;
+  EXPECT_NE(log.find("restarting from checkpoints/step-"), std::string::npos) << log;
+  // The side's frame files: every frame, bit for bit (the killed run's frames past the checkpoint were dropped).
+  std::size_t datasets = 0;
+  expect_same_frames(a + "/solid.h5", b + "/solid.h5", datasets);
+  expect_same_frames(a + "/fluid.h5", b + "/fluid.h5", datasets);
+  EXPECT_GT(datasets, 100u);
+  const std::string manifest = read_file(b + "/run.json");
+  EXPECT_EQ(json_string(manifest, "status"), "completed");
+  EXPECT_EQ(json_number(manifest, "restart_step"), static_cast<double>(checkpoint));
+  EXPECT_NE(json_string(manifest, "restarted_from").find("checkpoints/step-"), std::string::npos);
+}
+
+// The other schemes: IMPLICIT (a block ends with the solid's next step begun, its grid
+// mid-step) on kgd-paper-field-ci, and Jacobi with an exchange every second step. The run's
+// directory is copied, its last checkpoint removed, and the copy continued from the one
+// before: it must end as the original did.
+void expect_continued_run_equal(const std::vector<std::string>& run_argv, const std::string& dir) {
+  const std::string a = dir + "/a", b = dir + "/b";
+  std::vector<std::string> argv = run_argv;
+  argv.insert(argv.end(), {"--out", a, "--quiet"});
+  const auto whole = run(argv, 120);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const auto steps = complete_checkpoints(a);
+  ASSERT_EQ(steps.size(), 2u);
+  fs::copy(a, b, fs::copy_options::recursive);
+  std::ostringstream last;
+  last << b << "/checkpoints/step-" << std::setw(12) << std::setfill('0') << steps.back();
+  fs::remove_all(last.str());
+  const auto restarted = run({bin("hfmpm"), "run", "--restart", b, "--quiet"}, 120);
+  ASSERT_EQ(restarted.exit_code, 0) << restarted.err;
+  EXPECT_EQ(json_number(read_file(b + "/run.json"), "restart_step"), static_cast<double>(steps.front()));
+  expect_same_history(read_csv(a + "/history.csv"), read_csv(b + "/history.csv"));
+  std::size_t datasets = 0;
+  expect_same_frames(a + "/solid.h5", b + "/solid.h5", datasets);
+  expect_same_frames(a + "/fluid.h5", b + "/fluid.h5", datasets);
+  for (const std::string role : {"solid", "fluid"}) {
+    EXPECT_EQ(read_file(a + "/" + role + "_received.csv"), read_file(b + "/" + role + "_received.csv")) << role;
+  }
+}
+
+TEST(Restart, ImplicitAndJacobiSchemesContinueBitForBit) {
+  const auto dir = scratch_dir("restart-schemes");
+  expect_continued_run_equal(
+      {bin("hfmpm"), "run", source("scenarios/kgd-paper-field-ci.scene"), "--set", "time.end_s=30", "--set",
+       "output.interval_s=2", "--set", "output.checkpoint_interval_s=10", "--set", "output.exchange_log=true"},
+      dir + "/implicit");
+  expect_continued_run_equal(
+      {bin("hfmpm"), "run", source("scenarios/kgd-viscosity-ci.scene"), "--set", "time.end_s=0.2", "--set",
+       "output.interval_s=0.05", "--set", "output.checkpoint_interval_s=0.06", "--set", "output.exchange_log=true",
+       "--set", "coupling.scheme=JACOBI", "--set", "coupling.exchange_interval=2"},
+      dir + "/jacobi");
+}
+
+TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {
+  const auto dir = scratch_dir("restart-refused");
+  const std::string out = dir + "/run";
+  auto args = run_args(out);
+  args[std::find(args.begin(), args.end(), "time.end_s=0.4") - args.begin()] = "time.end_s=0.2";
+  args[std::find(args.begin(), args.end(), "output.checkpoint_interval_s=0.15") - args.begin()] =
+      "output.checkpoint_interval_s=0.05";
+  const auto first = run(args, 120);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const auto steps = complete_checkpoints(out);
+  ASSERT_EQ(steps.size(), 2u) << "the last two complete checkpoints are kept";
+  write_file(dir + "/history-first.csv", read_file(out + "/history.csv"));
+
+  // Another scene: the same file with other --set values.
+  std::vector<std::string> other{bin("hfmpm"), "run", "--restart", out, source("scenarios/kgd-viscosity-ci.scene")};
+  other.insert(other.end(), kSets.begin(), kSets.end());
+  const auto another = run(other, 60);
+  EXPECT_EQ(another.exit_code, 2);
+  EXPECT_NE(another.err.find("was written for another scene"), std::string::npos) << another.err;
+
+  // No checkpoint at all.
+  const auto none = run({bin("hfmpm"), "run", "--restart", dir}, 60);
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.err.find("no complete checkpoint"), std::string::npos) << none.err;
+
+  // A side's file of another step in the last checkpoint: the side refuses it, naming the step.
+  const std::string last = out + "/checkpoints/step-" + [&] {
+    std::ostringstream s;
+    s << std::setw(12) << std::setfill('0') << steps.back();
+    return s.str();
+  }();
+  const std::string before = out + "/checkpoints/step-" + [&] {
+    std::ostringstream s;
+    s << std::setw(12) << std::setfill('0') << steps.front();
+    return s.str();
+  }();
+  fs::copy_file(last + "/fluid.h5", dir + "/fluid.h5");
+  fs::copy_file(before + "/fluid.h5", last + "/fluid.h5", fs::copy_options::overwrite_existing);
+  const auto mixed = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 60);
+  EXPECT_EQ(mixed.exit_code, 1);
+  EXPECT_NE(mixed.err.find("has step = '" + std::to_string(steps.front()) + "', this run needs '" +
+                           std::to_string(steps.back()) + "'"),
+            std::string::npos)
+      << mixed.err;
+  fs::copy_file(dir + "/fluid.h5", last + "/fluid.h5", fs::copy_options::overwrite_existing);
+
+  // Another program version in the coupler's file.
+  checkpoint::CouplerState state;
+  {
+    std::ifstream in(last + "/coupler.pb", std::ios::binary);
+    ASSERT_TRUE(state.ParseFromIstream(&in));
+  }
+  const std::string good = read_file(last + "/coupler.pb");
+  state.set_program_version("0.0.1");
+  {
+    std::ofstream out_file(last + "/coupler.pb", std::ios::binary);
+    ASSERT_TRUE(state.SerializeToOstream(&out_file));
+  }
+  const auto version = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 60);
+  EXPECT_EQ(version.exit_code, 2);
+  EXPECT_NE(version.err.find("was written by hfmpm 0.0.1; this is hfmpm"), std::string::npos) << version.err;
+  write_file(last + "/coupler.pb", good);
+
+  // After the refusals the checkpoint still continues the run (with its own scene).
+  const auto ok = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 60);
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  expect_same_history(read_csv(dir + "/history-first.csv"), read_csv(out + "/history.csv"));
+}
+
+}  // namespace
+}  // namespace hfmpm::test
