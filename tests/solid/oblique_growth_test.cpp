@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "fracture_setup.hpp"
@@ -469,6 +471,75 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
       EXPECT_NEAR(j_over_k(tip), 1, 0.07) << "re-solve of the end tip's check " << g.end_grown;
       EXPECT_NEAR(g.tip.k1 / tip.k1, 1, 0.03) << "re-solve of the end tip's check " << g.end_grown;
     }
+  }
+}
+
+// A checkpoint of a crack that has kinked restores it bit for bit. The face
+// terms of J and M on segments off the tip's axis read the crack particles'
+// reference positions (Crack::reference), which growth estimates; before they
+// were checkpointed, a solver loaded from a checkpoint of a grown crack kept
+// the reference positions of the scene's initial particles only (and read
+// past their end for the new ones). The inclined crack under tension is grown
+// two steps per tip (past the kink: off-axis segments in both tips' domains),
+// saved, loaded into a new solver from the same config, and both are stepped
+// 400 steps (a growth step of each tip and its settling in between); the
+// particles, the crack and J and K at the tips must agree exactly.
+class MemoryState final : public StateWriter, public StateReader {
+ public:
+  void f64(const std::string& name, const std::vector<double>& v) override { reals_[name] = v; }
+  void u64(const std::string& name, const std::vector<std::uint64_t>& v) override { ints_[name] = v; }
+  void text(const std::string& name, const std::string& bytes) override { texts_[name] = bytes; }
+  std::vector<double> f64(const std::string& name) const override { return reals_.at(name); }
+  std::vector<std::uint64_t> u64(const std::string& name) const override { return ints_.at(name); }
+  std::string text(const std::string& name) const override { return texts_.at(name); }
+
+ private:
+  std::map<std::string, std::vector<double>> reals_;
+  std::map<std::string, std::vector<std::uint64_t>> ints_;
+  std::map<std::string, std::string> texts_;
+};
+
+TEST(ObliqueGrowth, CheckpointOfAKinkedCrackRestartsBitForBit) {
+  const double h = kA / 5, b = 5 * kA, k_ic = 1e6;
+  SolidConfig c = oblique_crack(h, b, kPi / 4, Vec2(h / 2, 0), 0, 0, k_ic);
+  const double sigma_c = k_ic / (std::sqrt(kPi * kA) / std::sqrt(2.0));
+  const double transit = transit_time(b);
+  const auto sigma = TimeFunction::table({0, 20 * transit}, {0, 1.3 * sigma_c});
+  c.tractions = {{Edge::Top, sigma, TimeFunction::constant(0)}, {Edge::Bottom, sigma, TimeFunction::constant(0)}};
+  Solver solid(c);
+  const auto log = grow(
+      solid, [](double) { return 0.0; }, [&](int s, int e) { return s >= 2 && e >= 2; }, 120 * transit);
+  ASSERT_GE(log.size(), 4u) << "the crack did not grow two steps per tip";
+  MemoryState saved;
+  solid.save(saved);
+  Solver again(c);
+  again.load(saved);
+  ASSERT_EQ(again.cracks()[0].reference().size(), solid.cracks()[0].size());
+  const double dt = solid.stable_dt();
+  const std::size_t before = solid.cracks()[0].size();
+  for (int k = 0; k < 400; ++k) {
+    solid.step(dt);
+    again.step(dt);
+  }
+  const auto& one = solid.cracks()[0];
+  const auto& two = again.cracks()[0];
+  EXPECT_GT(one.size(), before) << "no growth after the checkpoint: the test would not read new reference positions";
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t k = 0; k < one.size(); ++k) {
+    EXPECT_EQ(one.plane()[k], two.plane()[k]) << "crack particle " << k;
+    EXPECT_EQ(one.reference()[k], two.reference()[k]) << "crack particle " << k;
+  }
+  std::size_t differ = 0;
+  for (std::size_t p = 0; p < solid.particles().size(); ++p) {
+    if (solid.particles().x[p] != again.particles().x[p]) ++differ;
+  }
+  EXPECT_EQ(differ, 0u) << "particles whose position differs after the restart";
+  const auto tips = solid.tips(), tips_again = again.tips();
+  ASSERT_EQ(tips.size(), tips_again.size());
+  for (std::size_t k = 0; k < tips.size(); ++k) {
+    EXPECT_EQ(tips[k].j, tips_again[k].j);
+    EXPECT_EQ(tips[k].k1, tips_again[k].k1);
+    EXPECT_EQ(tips[k].k2, tips_again[k].k2);
   }
 }
 
