@@ -57,12 +57,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
-#include <map>
 #include <numbers>
-#include <string>
 
 #include "hfmpm/solid/mpm/predicates.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
@@ -99,18 +95,6 @@ DomainWeight domain_weight(double x1, double x2, double ri, double ro) {
 }
 
 constexpr double kPi = std::numbers::pi;
-
-// TEMPORARY diagnostic (issue 18 layered bisection): HFMPM_I18_OLD=jface uses
-// main's J face term (no off-axis terms), =main main's chord frame and face work.
-int i18_old() {
-  static const int mode = [] {
-    const char* e = std::getenv("HFMPM_I18_OLD");
-    if (e == nullptr) return 0;
-    const std::string v(e);
-    return v == "jface" ? 1 : v == "main" ? 2 : v == "mface" ? 3 : 0;
-  }();
-  return mode;
-}
 
 // Williams' near-tip field of unit K in plane strain, in the tip frame at
 // polar coordinates (r, theta) about the tip: stress, displacement and its
@@ -409,28 +393,6 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
   static constexpr std::array<double, 4> kGaussW = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
                                                     0.3478548451374538};
   TipSums sums;
-  if (i18_old() == 2) {
-    const double modulus = config_.materials[material].plane_strain_modulus();
-    auto old_aux = [&](std::size_t k) {
-      return 8 * std::sqrt((crack.plane()[k] - f.position).norm() / (2 * kPi)) / modulus;
-    };
-    for (std::size_t i = 0; i + 1 < n; ++i) {
-      const std::size_t a = at(i), b = at(i + 1);
-      const Vec2 mid = 0.5 * (crack.plane()[a] + crack.plane()[b]);
-      const Vec2 d = mid - f.position;
-      const double q = domain_weight(d.dot(f.e1), d.dot(f.e2), ri, ro).q;
-      if (q == 0) continue;
-      const Vec2 t = (crack.plane()[b] - crack.plane()[a]).normalized();
-      const Vec2 n_up(-t.y(), t.x());
-      Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
-      load += traction(in_situ_stress(mid), n_up);
-      sums.j -= q * load.dot(jump(b) - jump(a));
-      const double step = old_aux(b) - old_aux(a);
-      sums.m1 -= q * load.dot(f.e2) * step;
-      sums.m2 -= q * load.dot(f.e1) * step;
-    }
-    return sums;
-  }
   for (std::size_t i = 0; i + 1 < n; ++i) {
     const std::size_t a = at(i), b = at(i + 1);
     const Vec2& pa = crack.plane()[a];
@@ -447,7 +409,7 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
     const Vec2 load_f = f.rot * load, s_f = f.rot * t, n_f = f.rot * n_up;  // tip frame
     const auto ja = aux_jump(pa), jb = aux_jump(pb);
     if (q > 0) {
-      sums.j -= q * (i18_old() == 1 ? 1.0 : s_f.x()) * load.dot(jump(b) - jump(a));
+      sums.j -= q * s_f.x() * load.dot(jump(b) - jump(a));
       sums.m1 -= q * s_f.x() * load_f.dot(jb[0] - ja[0]);
       sums.m2 -= q * s_f.x() * load_f.dot(jb[1] - ja[1]);
     }
@@ -455,7 +417,7 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
     // Off the domain (q = 0 beyond sqrt(2) ro): nothing more.
     if (std::min((pa - f.position).norm(), (pb - f.position).norm()) - len > std::sqrt(2.0) * ro) continue;
     const Vec2 du_mean = 0.5 * (gradient_at(mid, 1, a, b) + gradient_at(mid, -1, a, b)) * s_f;  // d(mean u)/ds
-    if (q > 0 && i18_old() != 1) {
+    if (q > 0) {
       // Each face's field from its tangential gradient and its traction
       // (sigma n = -load on both faces, plane strain).
       const Vec2 du_jump = f.rot * (jump(b) - jump(a)) / len;  // d[u]/ds
@@ -476,7 +438,7 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
       const Vec2 x = pa + 0.5 * (1 + kGaussX[gp]) * (pb - pa);
       const Vec2 dx = x - f.position;
       const double w = 0.5 * len * kGaussW[gp] * domain_weight(dx.dot(f.e1), dx.dot(f.e2), ri, ro).q;
-      if (w == 0 || i18_old() == 3) continue;
+      if (w == 0) continue;
       const auto up = aux_at(x, 1), down = aux_at(x, -1);
       for (std::size_t mode = 0; mode < 2; ++mode) {
         const NearTipField& u = up[mode];
@@ -498,27 +460,7 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
   const Crack& crack = cracks_[c];
   const double h = config_.grid.h;
   const double ri = config_.fracture.inner_cells * h, ro = config_.fracture.outer_cells * h;
-  TipFrame frame = tip_frame(crack, at_end);
-  if (i18_old() == 2) {
-    const std::size_t n = crack.size();
-    auto at = [&](std::size_t i) { return at_end ? i : n - 1 - i; };
-    Vec2 back = crack.plane()[at(0)];
-    double along = 0;
-    for (std::size_t i = n - 1; i > 0; --i) {
-      const Vec2& a = crack.plane()[at(i)];
-      const Vec2& b = crack.plane()[at(i - 1)];
-      const double len = (b - a).norm();
-      if (along + len >= ri) {
-        back = a + (ri - along) / len * (b - a);
-        break;
-      }
-      along += len;
-    }
-    frame.e1 = (frame.position - back).normalized();
-    frame.e2 = Vec2(-frame.e1.y(), frame.e1.x());
-    frame.rot.row(0) = frame.e1.transpose();
-    frame.rot.row(1) = frame.e2.transpose();
-  }
+  const TipFrame frame = tip_frame(crack, at_end);
   TipResult tip;
   tip.crack = c;
   tip.at_end = at_end;
@@ -568,11 +510,7 @@ int Solver::propagate() {
       const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
       if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
     }
-    static std::map<std::pair<std::size_t, bool>, double> front_since;
-    static const double front_wait =
-        std::getenv("HFMPM_I18_FRONTWAIT") ? std::atof(std::getenv("HFMPM_I18_FRONTWAIT")) : 0.0;
-    const auto key = std::make_pair(tip.crack, tip.at_end);
-    if (front_since.find(key) == front_since.end()) front_since[key] = kForever;
+    if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
     if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
       // The front need not enter the tip segment (its faces close to nothing at
       // the tip): the allowed lag is at least that segment.
@@ -580,14 +518,8 @@ int Solver::propagate() {
       const std::vector<double> arc = arc_length(plane);
       const double dry = arc.back() - cracks_[tip.crack].wetted_length();
       const double allowed = std::max(config_.fracture.max_lag_cells * h, arc.back() - arc[arc.size() - 2]);
-      if (dry > allowed * (1 + 1e-9)) {
-        front_since[key] = kForever;
-        continue;  // wait for the fluid (zero-lag closure)
-      }
-      if (front_since[key] == kForever) front_since[key] = t_;
-      if (t_ - front_since[key] < front_wait) continue;
+      if (dry > allowed * (1 + 1e-9)) continue;  // wait for the fluid (zero-lag closure)
     }
-    if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
     const double kink = straight ? 0.0 : tip.kink;
     const double c = std::cos(kink), s = std::sin(kink);
     const Vec2 d(c * tip.direction.x() - s * tip.direction.y(), s * tip.direction.x() + c * tip.direction.y());
@@ -630,13 +562,6 @@ int Solver::propagate() {
     } else {
       crack.prepend(next, reference);
     }
-    if (std::getenv("HFMPM_I18_LOG") != nullptr) {
-      std::fprintf(stderr, "I18GROW t=%.5f tip=(%.3f,%+.3f) dir=%.1f J=%.4g GK=%.4g K1=%.4g K2/K1=%+.3f kink=%+.1f\n",
-                   t_, tip.position.x(), tip.position.y(), std::atan2(tip.direction.y(), tip.direction.x()) * 180 / kPi,
-                   tip.j, (tip.k1 * tip.k1 + tip.k2 * tip.k2) / tip.modulus, tip.k1, tip.k2 / tip.k1,
-                   tip.kink * 180 / kPi);
-    }
-    front_since[key] = kForever;
     grown_at = t_;
     ++added;
   }
