@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 #include <string>
 #include <vector>
@@ -251,22 +252,30 @@ Turned turn_in_anisotropic_stress(double h, double length) {
   // The dynamic term (HFMPM_ANISOTROPIC_STATIC=n): the crack of each of the
   // first n checks that grew a tip, re-solved from rest under that check's
   // pressure (held, damped over 12 transits).
+  // HFMPM_RESOLVE_DOMAIN=i,o evaluates the re-solves over a J domain of i-o
+  // cells instead of the test's 3-7 (path independence).
   const int statics = std::getenv("HFMPM_ANISOTROPIC_STATIC") ? std::atoi(std::getenv("HFMPM_ANISOTROPIC_STATIC")) : 0;
   for (const auto& g : log) {
     if ((g.tip.at_end ? g.end_grown : g.start_grown) > statics) continue;
     SolidConfig rest = c;
     rest.fracture.propagate = false;
     rest.cracks[0].points = g.before;
+    if (std::getenv("HFMPM_RESOLVE_DOMAIN")) {
+      rest.fracture.inner_cells = std::atof(std::getenv("HFMPM_RESOLVE_DOMAIN"));
+      rest.fracture.outer_cells = std::atof(std::strchr(std::getenv("HFMPM_RESOLVE_DOMAIN"), ',') + 1);
+    }
     Solver again(rest);
     again.cracks()[0].pressure().assign(g.before.size(), pressure(g.time));
     settle(again, 2 * b, 12);
     for (const auto& tip : again.tips()) {
       if (tip.at_end != g.tip.at_end) continue;
       std::printf(
-          "re-solve from rest, %s tip's check %d (p %.4e Pa): J %.4e J/m^2 (growth run %.4e), "
-          "J/((K_I^2+K_II^2)/E') %.4f (growth run %.4f), K_I %.4e (growth run %.4e), K_II/K_I %+.4f (%+.4f)\n",
-          tip.at_end ? "end" : "start", tip.at_end ? g.end_grown : g.start_grown, pressure(g.time), tip.j, g.tip.j,
-          j_over_k(tip), j_over_k(g.tip), tip.k1, g.tip.k1, tip.k2 / tip.k1, g.tip.k2 / g.tip.k1);
+          "re-solve from rest, %s tip's check %d (p %.4e Pa, J domain %g-%g cells): J %.4e J/m^2 (faces %.4e; "
+          "growth run %.4e), J/((K_I^2+K_II^2)/E') %.4f (growth run %.4f), K_I %.4e (growth run %.4e), K_II/K_I "
+          "%+.4f (%+.4f)\n",
+          tip.at_end ? "end" : "start", tip.at_end ? g.end_grown : g.start_grown, pressure(g.time),
+          rest.fracture.inner_cells, rest.fracture.outer_cells, tip.j, tip.j_faces, g.tip.j, j_over_k(tip),
+          j_over_k(g.tip), tip.k1, g.tip.k1, tip.k2 / tip.k1, g.tip.k2 / g.tip.k1);
     }
   }
   Turned out;
