@@ -5,15 +5,19 @@
 #include <sys/socket.h>
 #include <zmq.h>
 
-#include <algorithm>
 #include <arpa/inet.h>
+#include <linux/tcp.h>
+#include <netinet/in.h>
+
+#include <algorithm>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <map>
 #include <memory>
-#include <netinet/in.h>
 #include <set>
+#include <tuple>
 
 #include "hfmpm/runtime/transport.hpp"
 
@@ -39,6 +43,15 @@ std::string peer_of(int fd) {
     return "[" + std::string(text) + "]:" + std::to_string(ntohs(in->sin6_port));
   }
   return "?";
+}
+
+// Bytes the peer has sent on this tcp connection (0 if unknown).
+std::uint64_t bytes_received(int fd) {
+  tcp_info info{};
+  socklen_t length = sizeof(info);
+  if (getsockopt(fd, IPPROTO_TCP, TCP_INFO, &info, &length) != 0) return 0;
+  if (length < offsetof(tcp_info, tcpi_bytes_received) + sizeof(info.tcpi_bytes_received)) return 0;
+  return info.tcpi_bytes_received;
 }
 
 }  // namespace
@@ -129,19 +142,29 @@ void ConnectionCap::watch(zmq::socket_t& events) {
     for (int fd : admits) {
       if (open.count(fd)) admitted.insert(fd);
     }
-    // Over the cap: the oldest connections that have not proven to be a side go.
-    for (auto it = order.begin(); open.size() - admitted.size() > cap_ && it != order.end();) {
-      const int fd = it->second;
-      if (admitted.count(fd)) {
-        ++it;
-        continue;
+    // Over the cap: of the connections that have not proven to be a side,
+    // those that received the fewest bytes go first (an idle one, which never
+    // began the ZeroMQ greeting, before one that did), the oldest first among
+    // equals. A side sends its greeting and CURVE Hello as soon as it is
+    // connected, so it outranks every stranger that holds a connection idle.
+    const std::size_t strangers = open.size() - admitted.size();
+    if (strangers > cap_) {
+      std::vector<std::tuple<std::uint64_t, std::uint64_t, int>> candidates;  // bytes received, when accepted, fd
+      candidates.reserve(strangers);
+      for (const auto& [when, fd] : order) {
+        if (!admitted.count(fd)) candidates.emplace_back(bytes_received(fd), when, fd);
       }
-      last_peer = peer_of(fd);
-      ::shutdown(fd, SHUT_RDWR);  // ZeroMQ sees the peer leave, closes it and says DISCONNECTED
-      it = order.erase(it);
-      open.erase(fd);
-      ++dropped;
-      ++untold;
+      const std::size_t excess = strangers - cap_;
+      std::partial_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(excess), candidates.end());
+      for (std::size_t i = 0; i < excess; ++i) {
+        const auto [bytes, when, fd] = candidates[i];
+        last_peer = peer_of(fd);
+        ::shutdown(fd, SHUT_RDWR);  // ZeroMQ sees the peer leave, closes it and says DISCONNECTED
+        order.erase(when);
+        open.erase(fd);
+        ++dropped;
+        ++untold;
+      }
     }
     const auto now = std::chrono::steady_clock::now();
     if (untold > 0 && told_ && now - last_told > std::chrono::seconds(1)) {

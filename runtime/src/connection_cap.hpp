@@ -5,11 +5,13 @@
 // failing accept() (100% CPU) and nobody, a side included, gets in. This
 // watches the socket's connections (zmq_socket_monitor: accepted and
 // disconnected, with their descriptors) and, when more than `cap` are open
-// that have not carried a side's message, shuts down the oldest of them
-// (shutdown(2): ZeroMQ then sees the peer leave and closes it). A side's
-// connection is newest when it arrives and is admitted by its first message,
-// so a stranger must open `cap` connections within one handshake to push it
-// out, and then the side reconnects.
+// that have not carried a side's message, shuts down the excess
+// (shutdown(2): ZeroMQ then sees the peer leave and closes it): those that
+// received the fewest bytes (TCP_INFO), idle ones first, the oldest first
+// among equals. A side sends its greeting at once and is admitted by its
+// first message, so idle strangers never push it out, however many; strangers
+// that send partial greetings compete with it only during its handshake, and
+// then the side reconnects.
 #pragma once
 
 #include <atomic>

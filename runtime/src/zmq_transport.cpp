@@ -153,6 +153,10 @@ class ZmqTransport final : public Transport {
       make_curve_server(socket, security.curve->server_secret);
     }
     if (endpoint.rfind("tcp://", 0) == 0) {
+      // A long listen queue: a side's connection that arrives amid a flood
+      // waits in it for the next accept() instead of having its SYN dropped
+      // (the kernel retries a dropped SYN after 1 s, then 3 s).
+      socket.set(zmq::sockopt::backlog, kListenBacklog);
       router->limit(
           std::make_unique<ConnectionCap>(context_, socket, connection_cap_for_this_process(), security.refused));
     }

@@ -107,6 +107,7 @@ struct FloodOptions {
   bool old_zmtp = false;      // each connection sends a ZMTP 1.0 routing id; connections churn
   int teardowns = 0;          // > 0: that many couplers no side joins, torn down under the flood
   std::string bin_dir;        // the programs from here instead of this build's
+  double max_join_s = 0;      // > 0: a join under the flood slower than this is a problem
 };
 int flood_command(std::uint64_t connections, const FloodOptions& flood, const CommonOptions& options);
 

@@ -9,7 +9,7 @@
 // or the connection cap) is opened again at once. While the flood is held,
 // the real sides start; the run must complete, with the same history as the
 // run without the flood. Reported: the join time (sides started until
-// run.json says "running") with and without the flood, the coupler's CPU
+// coupler.log says both joined) with and without the flood, the coupler's CPU
 // share while the flood was held before the sides started, how many
 // connections the coupler closed.
 //
@@ -230,8 +230,11 @@ Trial trial(const FloodOptions& flood, const std::string& root, const std::strin
       holder->hold(0.005);
     else
       sleep_s(0.005);
-    if (!result.joined &&
-        test::json_string(test::read_file(dir + "/run.json"), "status").find("running") != std::string::npos) {
+    // Joined: both Hellos taken (coupler.log stays open; run.json is written
+    // anew each time, which a coupler out of descriptors cannot do).
+    const std::string log = result.joined ? std::string() : test::read_file(dir + "/coupler.log");
+    if (!result.joined && log.find("solid side joined") != std::string::npos &&
+        log.find("fluid side joined") != std::string::npos) {
       result.joined = true;
       result.join_s = seconds_since(sides_started);
     }
@@ -359,7 +362,9 @@ int flood_command(std::uint64_t connections, const FloodOptions& flood, const Co
     std::cout << "  coupler's stderr: " << flooded.err.substr(0, 600) << "\n";
   }
   if (options.verbose) std::cout << "  coupler log: " << flooded.dir << "/coupler.log\n";
-  return conclude(flooded.completed && same, root, options);
+  const bool slow = flood.max_join_s > 0 && (!flooded.joined || flooded.join_s > flood.max_join_s);
+  if (slow) std::cout << "  the join took longer than --max-join " << fixed(flood.max_join_s, 1) << " s\n";
+  return conclude(flooded.completed && same && !slow, root, options);
 }
 
 }  // namespace hfmpm::reliability

@@ -26,7 +26,7 @@ constexpr const char* kUsage = R"(usage:
       moment and continued with `hfmpm run --restart`: history.csv, the exchange
       logs and every HDF5 dataset must equal the uninterrupted run's bit for bit.
   hfmpm-reliability flood --connections N [--fd-limit L] [--insecure-tcp] [--old-zmtp]
-                          [--teardowns K] [--bin DIR] [--keep] [--verbose]
+                          [--teardowns K] [--max-join S] [--bin DIR] [--keep] [--verbose]
       `hfmpm coupler` (CURVE, stand-in scene, under `ulimit -n L` if given) while
       this tool holds N raw tcp connections to its port that never send a byte
       (reopening any the coupler closes); then the real sides join. The run must
@@ -35,7 +35,8 @@ constexpr const char* kUsage = R"(usage:
       --insecure-tcp: plain tcp. --old-zmtp: each connection sends a ZMTP 1.0
       routing id, an eighth of them reopened every 10 ms. --teardowns K: instead,
       K couplers that no side joins (join timeout 0.5 s) end under the flood;
-      counts crashes. --bin DIR: hfmpm and the stand-in sides from DIR.
+      counts crashes. --max-join S: a join slower than S seconds under the flood
+      is a problem. --bin DIR: hfmpm and the stand-in sides from DIR.
   hfmpm-reliability bad-scenes [--verbose]
       `hfmpm validate` on every file in tests/data/bad_scenes/.
 exit status: 0 nothing wrong found, 1 problems found, 2 bad command line.
@@ -76,6 +77,8 @@ int main(int argc, char** argv) {
         flood.old_zmtp = true;
       else if (arg == "--teardowns")
         flood.teardowns = std::stoi(value());
+      else if (arg == "--max-join")
+        flood.max_join_s = std::stod(value());
       else if (arg == "--bin")
         flood.bin_dir = value();
       else if (arg == "--seed")
