@@ -151,6 +151,14 @@ class ZmqTransport final : public Transport {
     if (security.curve) {
       router->guard(std::make_unique<ZapAuthenticator>(context_, security.curve->client_public, security.refused));
       make_curve_server(socket, security.curve->server_secret);
+    } else if (endpoint.rfind("tcp://", 0) == 0) {
+      // Plain tcp: a ZAP domain (with no handler, so every peer is admitted)
+      // makes ZeroMQ refuse ZMTP 1.0 and 2.0 peers at the greeting. libzmq
+      // 4.3.4 aborts the process (errno_assert, zmtp_engine.cpp:446) when
+      // such a peer's first frame, its routing id, completes while the
+      // socket is being closed; the sides all speak ZMTP 3
+      // (docs/reliability.md, "The libzmq abort").
+      socket.set(zmq::sockopt::zap_domain, std::string("hfmpm"));
     }
     if (endpoint.rfind("tcp://", 0) == 0) {
       // A long listen queue: a side's connection that arrives amid a flood

@@ -66,11 +66,12 @@ int open_connection(int port) {
 // replaced by a new one.
 class Flood {
  public:
-  // old_zmtp: each connection sends a ZMTP 1.0 routing id at once, and an
-  // eighth of them is closed and opened again every round (churn).
+  // old_zmtp: each connection sends a ZMTP 1.0 routing id, split over two
+  // rounds, and an eighth of them is closed and opened again every round (churn).
   // Opened at most kPerRound at a time, so that the listener's backlog (100)
   // does not overflow and delay connections by the kernel's SYN retries.
-  Flood(int port, std::size_t n, bool old_zmtp) : port_(port), old_zmtp_(old_zmtp), fds_(n, -1) {}
+  Flood(int port, std::size_t n, bool old_zmtp)
+      : port_(port), old_zmtp_(old_zmtp), fds_(n, -1), rest_pending_(n, false) {}
   ~Flood() {
     for (int fd : fds_) {
       if (fd >= 0) close(fd);
@@ -90,11 +91,21 @@ class Flood {
           fds_[next_] = -1;
         }
       }
+      if (old_zmtp_) {
+        // The rest of the routing id frames begun last round.
+        for (std::size_t i = 0; i < fds_.size(); ++i) {
+          if (fds_[i] < 0 || !rest_pending_[i]) continue;
+          rest_pending_[i] = false;
+          (void)::send(fds_[i], kOldZmtpRoutingId.data() + 2, kOldZmtpRoutingId.size() - 2,
+                       MSG_NOSIGNAL | MSG_DONTWAIT);
+        }
+      }
       constexpr std::size_t kPerRound = 50;
       std::size_t opened = 0;
       for (std::size_t i = 0; i < fds_.size(); ++i) {
         if (fds_[i] < 0 && opened < kPerRound) {
           fds_[i] = connect_one();
+          rest_pending_[i] = old_zmtp_ && fds_[i] >= 0;
           ++opened;
         }
         items[i] = {fds_[i], POLLIN, 0};
@@ -123,11 +134,11 @@ class Flood {
   int connect_one() {
     const int fd = open_connection(port_);
     if (fd >= 0 && old_zmtp_) {
-      // Wait briefly for the connection, then send the routing id.
+      // Wait briefly for the connection, then send the routing id frame's
+      // length and flags; the rest follows next round (a frame split across
+      // tcp segments, as a slow peer's is).
       pollfd item{fd, POLLOUT, 0};
-      if (poll(&item, 1, 20) > 0) {
-        (void)::send(fd, kOldZmtpRoutingId.data(), kOldZmtpRoutingId.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
-      }
+      if (poll(&item, 1, 20) > 0) (void)::send(fd, kOldZmtpRoutingId.data(), 2, MSG_NOSIGNAL | MSG_DONTWAIT);
     }
     return fd;
   }
@@ -136,6 +147,7 @@ class Flood {
   bool old_zmtp_;
   std::size_t next_ = 0;
   std::vector<int> fds_;
+  std::vector<bool> rest_pending_;  // old_zmtp: the rest of the routing id is still to be sent
   std::uint64_t closed_ = 0;
 };
 
