@@ -64,7 +64,8 @@ std::optional<Routed> receive_routed(zmq::socket_t& router, std::chrono::microse
   routed.peer = parts.front().to_string();
   routed.well_framed = parts.size() == 2;
   if (parts.size() >= 2) routed.payload = parts[1].to_string();
-  routed.source_fd = parts.back().get(ZMQ_SRCFD);  // -1 without a descriptor (inproc)
+  // The connection's descriptor; -1 without one (inproc; cppzmq's get() would throw).
+  routed.source_fd = zmq_msg_get(parts.back().handle(), ZMQ_SRCFD);
   return routed;
 }
 
