@@ -250,8 +250,7 @@ TEST(Restart, CouplerWithSidesStartedByHandContinues) {
   // --restart is for run and coupler only.
   const auto validate = run({bin("hfmpm"), "validate", "--restart", b}, 20);
   EXPECT_EQ(validate.exit_code, 2);
-  EXPECT_NE(validate.err.find("--restart is for 'hfmpm run' and 'hfmpm coupler'"), std::string::npos)
-      << validate.err;
+  EXPECT_NE(validate.err.find("--restart is for 'hfmpm run' and 'hfmpm coupler'"), std::string::npos) << validate.err;
 }
 
 TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {

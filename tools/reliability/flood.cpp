@@ -227,10 +227,17 @@ Trial trial(const FloodOptions& flood, const std::string& root, const std::strin
     result.coupler_cpu_share = (cpu_seconds(coupler.pid()) - cpu0) / hold_before_s;
   }
   const auto sides_started = Clock::now();
-  std::vector<std::string> solid_argv{program(flood, "hfmpm-prescribed-solid"), "--connect", endpoint, "--out", dir,
-                                      "--advertise-host", "127.0.0.1", "--welcome-timeout", "60"};
-  std::vector<std::string> fluid_argv{program(flood, "hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", dir,
-                                      "--welcome-timeout", "60"};
+  std::vector<std::string> solid_argv{program(flood, "hfmpm-prescribed-solid"),
+                                      "--connect",
+                                      endpoint,
+                                      "--out",
+                                      dir,
+                                      "--advertise-host",
+                                      "127.0.0.1",
+                                      "--welcome-timeout",
+                                      "60"};
+  std::vector<std::string> fluid_argv{
+      program(flood, "hfmpm-prescribed-fluid"), "--connect", endpoint, "--out", dir, "--welcome-timeout", "60"};
   if (!flood.insecure_tcp) {
     for (auto* argv : {&solid_argv, &fluid_argv}) argv->insert(argv->end(), {"--keys", keys.side});
   }

@@ -7,9 +7,9 @@
 // (docs/reliability.md, "A coupler killed with SIGKILL").
 #pragma once
 
+#include <sys/types.h>
 #include <cstdint>
 #include <string>
-#include <sys/types.h>
 
 namespace hfmpm::coupling {
 
