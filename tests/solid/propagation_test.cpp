@@ -267,17 +267,20 @@ namespace {
 // particle: the crack particles' surfaces (what the fluid sees) and the
 // material's, the displacement of the nearest particle on each side
 // extrapolated to the crack particle with its displacement gradient.
-// Measured (3 December): on a node row both agree with the cut crack within
-// 0.6% from three cells behind the tip (the surfaces of one grown particle
-// 15% low); between node rows, where the KGD scenes put their cracks, the
-// grown crack's material opening is 4-14% and its surfaces' 18-35% below the
-// cut crack's, and the particles beside the grown faces keep stresses of
-// +-2 MPa (three times the remote tension) that the cut crack's do not: the
-// across-the-crack node fields are light (an 8th of a node), and their
-// equilibrium leaves the stresses of the first particle rows free, so the
-// static state remembers the uncut body. docs/verification.md ("What limits
-// the KGD length"). Disabled: it fails between node rows (open) and takes
-// about 3 minutes; run with --gtest_also_run_disabled_tests.
+// Compared from 1.5 cells behind the tip (the grown part is the last two
+// cells; the particle half a cell from the tip is left out). Measured (3
+// December), grown / cut at 2, 1.5 cells: on a node row the material 1.0005,
+// 0.994 and the surfaces 1.000, 0.84 (and 0.93 at 2.5 cells: the surfaces
+// drift where the body is right); between node rows, where the KGD scenes
+// put their cracks, the material 0.885, 0.964 and the surfaces 0.82, 0.81
+// (0.78, 0.65 nearer the tip), and the particles beside the grown faces keep
+// stresses of +-2 MPa (three times the remote tension) that the cut crack's
+// do not: the across-the-crack node fields are light (an 8th of a node), and
+// their equilibrium leaves the stresses of the first particle rows free, so
+// the static state remembers the uncut body. docs/verification.md ("What
+// limits the KGD length"). Disabled: it fails (the surfaces on a node row,
+// both openings between node rows: open, issue 17) and takes about 2
+// minutes; run with --gtest_also_run_disabled_tests.
 struct OpeningProfile {
   std::vector<double> x, surfaces, material;
 };
@@ -341,7 +344,7 @@ TEST(Propagation, DISABLED_GrownCrackOpensAsACrackCutAtThatLength) {
     for (std::size_t k = 1; k + 1 < cut.x.size(); ++k) {
       const double rs = grown.surfaces[k] / cut.surfaces[k], rm = grown.material[k] / cut.material[k];
       std::printf("  %.4f %.4f %.4f\n", cut.x[k], rs, rm);
-      if (tip - cut.x[k] < 2.5 * h) continue;  // the tip's own cells
+      if (tip - cut.x[k] < 1.5 * h - 1e-9) continue;  // the particle next to the tip
       EXPECT_NEAR(rm, 1, 0.02) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
       EXPECT_NEAR(rs, 1, 0.02) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
     }
