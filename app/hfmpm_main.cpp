@@ -9,10 +9,12 @@
 #include <map>
 
 #include "hfmpm/coupling/coupler.hpp"
+#include "hfmpm/coupling/run_cost.hpp"
 #include "hfmpm/coupling/run_state.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
 #include "hfmpm/runtime/curve.hpp"
+#include "hfmpm/solid/mpm/solver.hpp"
 #include "mpm_fluid_side.hpp"
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
@@ -50,7 +52,8 @@ constexpr const char* kUsage = R"(usage:
       (coupler killed?). 'hfmpm run --restart DIR' does the same.
   hfmpm validate SCENE [--set KEY=VALUE]... [--json]
       Check SCENE and print it with every default filled in (--json: as JSON, for
-      scripts; every run also writes it to OUT/scene.json).
+      scripts; every run also writes it to OUT/scene.json), after what the run will
+      cost: particles, grid nodes, the step, the steps to end_s, an estimated wall time.
 
 options:
   --out DIR            output directory (default: hfmpm-out/SCENE_NAME)
@@ -260,7 +263,11 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     }
     std::string text;
     google::protobuf::TextFormat::PrintToString(filled, &text);
-    std::cout << "# " << scene_path << ": valid\n" << text;
+    double particles = 0;  // the MPM solid's own count (regions may overlap)
+    if (filled.solid().has_mpm())
+      particles = solid::mpm::Solver(solid::to_solid_config(filled.solid().mpm())).particles().size();
+    std::cout << "# " << scene_path << ": valid\n"
+              << coupling::describe(coupling::estimate_run_cost(filled, particles)) << text;
     return 0;
   }
   if (!options.keys_file.empty() && command != "coupler") {
