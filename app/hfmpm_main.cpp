@@ -9,9 +9,12 @@
 #include <map>
 
 #include "hfmpm/coupling/coupler.hpp"
+#include "hfmpm/coupling/run_cost.hpp"
+#include "hfmpm/coupling/run_state.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
 #include "hfmpm/runtime/curve.hpp"
+#include "hfmpm/solid/mpm/solver.hpp"
 #include "mpm_fluid_side.hpp"
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
@@ -34,13 +37,23 @@ constexpr const char* kUsage = R"(usage:
         hfmpm coupler s.scene --bind tcp://0.0.0.0:5555 --keys keys/coupler.keys
         hfmpm-solid --connect tcp://COUPLER_HOST:5555 --keys side.keys   (on the solid's host)
         hfmpm-fluid --connect tcp://COUPLER_HOST:5555 --keys side.keys   (on the fluid's host)
+  hfmpm coupler --restart DIR [SCENE [--set KEY=VALUE]...] --bind ENDPOINT [--keys FILE] [--quiet]
+      Continue the run in DIR from its last complete checkpoint with sides started
+      by hand: start each side as before, with the same --out as in the first run
+      (each side reads its own checkpoint file under it; without --out, DIR).
   hfmpm keygen DIR
       Write a CURVE key pair for the coupler and one for the sides: DIR/coupler.keys
       and DIR/side.keys (0600, DIR 0700). A coupler on tcp admits only sides that
       hold side.keys; nothing secret goes into run.json or onto a command line.
+  hfmpm status DIR
+      Say whether the run in DIR is running, finished, or stopped without
+      finishing: a run.json left at "running" by a coupler that was killed
+      (kill -9, a crash, a reboot) gets the status: stopped without finishing
+      (coupler killed?). 'hfmpm run --restart DIR' does the same.
   hfmpm validate SCENE [--set KEY=VALUE]... [--json]
       Check SCENE and print it with every default filled in (--json: as JSON, for
-      scripts; every run also writes it to OUT/scene.json).
+      scripts; every run also writes it to OUT/scene.json), after what the run will
+      cost: particles, grid nodes, the step, the steps to end_s, an estimated wall time.
 
 options:
   --out DIR            output directory (default: hfmpm-out/SCENE_NAME)
@@ -52,7 +65,7 @@ options:
                        who can reach the port can join. 'run' makes keys itself.
   --solid-program P    run another solid implementation (speaks docs/protocol.md)
   --fluid-program P    run another fluid implementation
-  --restart DIR        run: continue the run in DIR from its last complete checkpoint
+  --restart DIR        run, coupler: continue the run in DIR from its last complete checkpoint
   --quiet              no progress line
   --help, -h           this text (also after a command: hfmpm run --help)
 exit status: 0 success, 1 run failed, 2 bad scene or command line,
@@ -94,6 +107,42 @@ int keygen(const std::vector<std::string>& args) {
   coupling::write_side_key_file((dir / "side.keys").string(), keys);
   std::cout << "hfmpm: wrote " << (dir / "coupler.keys").string() << " (keep it with the coupler: --keys) and "
             << (dir / "side.keys").string() << " (copy it to each side's host: --keys)\n";
+  return 0;
+}
+
+std::string describe(const coupling::RunState& state) {
+  return "coupler pid " + std::to_string(state.pid) + " on " + state.host + ", started " + state.started_at;
+}
+
+// `hfmpm status DIR`; 0 when run.json was read, 2 for a bad command line.
+int status(const std::vector<std::string>& args) {
+  if (args.size() != 1 || args[0].empty() || args[0][0] == '-') {
+    throw UsageError("'hfmpm status' takes one run directory: hfmpm status DIR");
+  }
+  const std::string& dir = args[0];
+  coupling::RunState state;
+  try {
+    state = coupling::check_run_state(dir, true);
+  } catch (const std::runtime_error& e) {
+    std::cerr << "hfmpm: " << dir << ": " << e.what() << "\n";
+    return 2;
+  }
+  using Coupler = coupling::RunState::Coupler;
+  switch (state.coupler) {
+    case Coupler::finished:
+      std::cout << dir << ": " << state.status << "\n";
+      break;
+    case Coupler::alive:
+      std::cout << dir << ": " << state.status << " (" << describe(state) << ")\n";
+      break;
+    case Coupler::other_host:
+      std::cout << dir << ": " << state.status << " according to run.json, but " << state.detail << "\n";
+      break;
+    case Coupler::gone:
+      std::cout << dir << ": " << coupling::kStoppedWithoutFinishing << ": run.json said \"" << state.status
+                << "\", but " << state.detail << " (" << describe(state) << "); recorded in run.json\n";
+      break;
+  }
   return 0;
 }
 
@@ -146,12 +195,36 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   }
   std::shared_ptr<coupling::RestartPoint> restart_point;
   if (!restart.empty()) {
-    if (command != "run") throw UsageError("--restart is for 'hfmpm run'");
+    if (command == "validate") throw UsageError("--restart is for 'hfmpm run' and 'hfmpm coupler'");
     if (!out.empty()) throw UsageError("--restart DIR continues in DIR; --out is not allowed with it");
     if (scene_path.empty() && !overrides.empty()) {
       throw UsageError(
           "--set and --transport need the scene file: hfmpm run --restart DIR SCENE --set ... (the run's own scene "
           "and overrides; without SCENE the checkpoint's scene is used as it is)");
+    }
+    // The run being continued must not be running; a coupler that was killed
+    // left run.json at "running", which is recorded as stopped now.
+    try {
+      const auto state = coupling::check_run_state(restart, true);
+      using Coupler = coupling::RunState::Coupler;
+      if (state.coupler == Coupler::alive) {
+        std::cerr << "hfmpm: the run in " << restart << " is still running (" << describe(state)
+                  << "); stop it first (Ctrl-C, or kill " << state.pid << "), then restart\n";
+        return 2;
+      }
+      if (state.coupler == Coupler::other_host) {
+        std::cerr << "hfmpm: warning: run.json says \"" << state.status << "\" and " << state.detail
+                  << "; continuing: make sure it has stopped (two couplers must not share a directory)\n";
+      }
+      if (state.coupler == Coupler::gone) {
+        std::cerr << "hfmpm: the run in " << restart << " " << coupling::kStoppedWithoutFinishing << ": "
+                  << state.detail << "; continuing it from its last complete checkpoint\n";
+        options.previous_status = coupling::kStoppedWithoutFinishing;
+      } else {
+        options.previous_status = state.status;
+      }
+    } catch (const std::runtime_error&) {
+      // No readable run.json: find_restart below says what is missing.
     }
     try {
       restart_point = std::make_shared<coupling::RestartPoint>(coupling::find_restart(restart));
@@ -190,7 +263,11 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     }
     std::string text;
     google::protobuf::TextFormat::PrintToString(filled, &text);
-    std::cout << "# " << scene_path << ": valid\n" << text;
+    double particles = 0;  // the MPM solid's own count (regions may overlap)
+    if (filled.solid().has_mpm())
+      particles = solid::mpm::Solver(solid::to_solid_config(filled.solid().mpm())).particles().size();
+    std::cout << "# " << scene_path << ": valid\n"
+              << coupling::describe(coupling::estimate_run_cost(filled, particles)) << text;
     return 0;
   }
   if (!options.keys_file.empty() && command != "coupler") {
@@ -257,8 +334,9 @@ int main(int argc, char** argv) {
   }
   try {
     if (command == "keygen") return keygen(args);
+    if (command == "status") return status(args);
     if (command != "run" && command != "coupler" && command != "validate") {
-      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, validate, keygen");
+      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, status, validate, keygen");
     }
     return run(command, args);
   } catch (const UsageError& e) {

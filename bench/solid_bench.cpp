@@ -6,9 +6,18 @@
 //
 // --cells: the block's cells per side (default 200: 160,000 particles at 2 x 2
 // per cell); --uncracked-only skips the cracked case (its size is fixed).
+//
+// Then a roofline estimate: the machine's memory bandwidth (a STREAM-style
+// triad a = b + s c over 3 x 64 MB, 1 and 2 threads, best of 5), the bytes
+// one particle-step moves (a model, bytes_moved below), and the throughput
+// that bandwidth would allow against the measured one.
+#include <omp.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "hfmpm/solid/mpm/solver.hpp"
 
@@ -75,8 +84,51 @@ double bytes_per_particle(const Solver& solid) {
   return particle + grid / static_cast<double>(p.size());
 }
 
+// Bytes one particle-step moves to and from memory, from the arrays the step
+// touches (solid/src/mpm/transfer.cpp): P2G reads x, half size, mass, v,
+// stress, volume (and displacement with cracks); G2P reads x, half size, v,
+// material, stress and writes v, x, stress (with cracks also reads and writes
+// displacement and its gradient). The grid's arrays are counted twice per
+// step (P2G's accumulators written and reduced, the update and G2P reading
+// the fields), shared out per particle. Caches are ignored: the particle
+// arrays of the bench (25-40 MB) do not fit in them.
+double bytes_moved(const Solver& solid) {
+  const auto& p = solid.particles();
+  const bool cracked = !solid.cracks().empty();
+  const double x = sizeof(p.x[0]), v = sizeof(p.v[0]), stress = sizeof(p.stress[0]);
+  const double scalar = sizeof(p.mass[0]), material = sizeof(p.material[0]);
+  double bytes = (x + scalar + scalar + v + stress + scalar)  // P2G: x, half size, mass, v, stress, volume
+                 + (x + scalar + v + material + stress) + (v + x + stress);  // G2P reads, then writes
+  if (cracked) bytes += sizeof(p.displacement[0]) * 3 + sizeof(p.grad_u[0]) * 2;
+  return bytes + 2 * static_cast<double>(solid.grid_bytes()) / static_cast<double>(p.size());
+}
+
+// Memory bandwidth, GB/s: the triad a[i] = b[i] + s c[i] over arrays far
+// larger than the caches, 3 x 8 bytes per element plus the write-allocate
+// read of a (32 bytes counted per element), best of 5 passes.
+double triad_bandwidth(int threads) {
+  const std::size_t n = std::size_t{8} << 20;  // 8 M doubles: 64 MB per array
+  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
+  double best = 0;
+  for (int pass = 0; pass < 5; ++pass) {
+    const auto start = std::chrono::steady_clock::now();
+    const double s = 0.5 + pass;
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::size_t i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = std::max(best, 32.0 * static_cast<double>(n) / wall / 1e9);
+  }
+  if (a[n / 2] < 0) std::printf("impossible\n");  // keep the stores
+  return best;
+}
+
+struct Measured {
+  double rate = 0, bytes = 0;  // particle-steps/s (2 threads), bytes per particle-step
+};
+
 template <class Make>
-void run(const char* name, Make make, int size, int steps) {
+Measured run(const char* name, Make make, int size, int steps) {
+  Measured out;
   for (int threads : {1, 2}) {
     Solver solid(make(size, threads));
     if (!solid.cracks().empty()) solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), 1e6));
@@ -88,7 +140,10 @@ void run(const char* name, Make make, int size, int steps) {
     const double n = static_cast<double>(solid.particles().size());
     std::printf("| %s | %.0f | %d | %d | %.3f | %.3g | %.0f |\n", name, n, threads, steps, wall, n * steps / wall,
                 bytes_per_particle(solid));
+    out.rate = n * steps / wall;
+    out.bytes = bytes_moved(solid);
   }
+  return out;
 }
 
 }  // namespace
@@ -116,7 +171,16 @@ int main(int argc, char** argv) {
   std::printf(
       "| case | particles | threads | steps | wall (s) | particle-steps/s | bytes/particle |\n"
       "|---|---|---|---|---|---|---|\n");
-  run("uncracked block", block, cells, steps);
-  if (cracked_case) run("Sneddon, cracked (h = a/20)", cracked, 20, steps);
+  std::vector<std::pair<std::string, Measured>> cases{{"uncracked block", run("uncracked block", block, cells, steps)}};
+  if (cracked_case) cases.emplace_back("Sneddon, cracked", run("Sneddon, cracked (h = a/20)", cracked, 20, steps));
+  const double bw1 = triad_bandwidth(1), bw2 = triad_bandwidth(2);
+  std::printf("\nmemory bandwidth (triad, best of 5): %.1f GB/s on 1 thread, %.1f GB/s on 2\n", bw1, bw2);
+  std::printf(
+      "\n| case (2 threads) | bytes moved per particle-step (model) | bandwidth limit (particle-steps/s) | measured | "
+      "measured / limit |\n|---|---|---|---|---|\n");
+  for (const auto& [name, m] : cases) {
+    const double limit = bw2 * 1e9 / m.bytes;
+    std::printf("| %s | %.0f | %.3g | %.3g | %.2f |\n", name.c_str(), m.bytes, limit, m.rate, m.rate / limit);
+  }
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "coupler_session.hpp"
+#include "hfmpm/coupling/run_state.hpp"
 
 namespace hfmpm::coupling {
 
@@ -155,6 +156,10 @@ void Coupler::prepare() {
   manifest_.set_number("coupler_pid", static_cast<double>(getpid()));
   manifest_.set("coupler_host", host_name());
   manifest_.set("started_at", utc_now());
+  // The pid's start time and the boot: a later reader tells this coupler
+  // from another process that got its pid (check_run_state).
+  manifest_.set("coupler_start_ticks", std::to_string(process_start_ticks(getpid())));
+  manifest_.set("boot_id", boot_id());
   std::string overrides;
   for (const auto& o : options_.overrides) overrides += (overrides.empty() ? "" : " ") + o;
   manifest_.set("overrides", overrides);
@@ -172,6 +177,7 @@ void Coupler::prepare() {
     manifest_.set_number("restart_step", static_cast<double>(step_));
     manifest_.set_number("restart_time_s", t_);
     manifest_.set("restarted_run_id", r.state.run_id());
+    if (!options_.previous_status.empty()) manifest_.set("previous_status", options_.previous_status);
     log_("restarting from " + r.directory + " (step " + std::to_string(step_) + ", t = " + std::to_string(t_) + " s)");
   } else {
     history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable
@@ -237,15 +243,17 @@ void Coupler::prepare() {
         write_side_key_file(side_keys, keys);
       }
       security.curve = keys;
-      security.refused = [this](const std::string& line) {
-        std::lock_guard<std::mutex> lock(refusals_mutex_);
-        refusals_ += (refusals_.empty() ? "" : "\n") + line;
-      };
       curve_ = true;
       manifest_.set("tcp_security", "CURVE");
     }
   }
   side_keys_ = side_keys;
+  // Refused peers (CURVE) and connections closed beyond the cap (tcp), told
+  // by the transport's threads and logged by housekeeping().
+  security.refused = [this](const std::string& line) {
+    std::lock_guard<std::mutex> lock(refusals_mutex_);
+    refusals_ += (refusals_.empty() ? "" : "\n") + line;
+  };
   try {
     router_ = transport_->bind_router(bind, security);
   } catch (const zmq::error_t& e) {

@@ -89,8 +89,8 @@ void Coupler::housekeeping() {
   }
   last_housekeeping_ = now;
   if (!stepping_) check_stop_request();  // while the sides join; in the loop, between rounds
-  if (curve_) {
-    std::string refusals;
+  {
+    std::string refusals;  // CURVE refusals, connections closed beyond the cap
     {
       std::lock_guard<std::mutex> lock(refusals_mutex_);
       refusals.swap(refusals_);

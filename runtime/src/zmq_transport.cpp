@@ -3,6 +3,8 @@
 // (linger, message-size limits, handshake timeout, CURVE on tcp).
 #include "hfmpm/runtime/zmq_transport.hpp"
 
+#include "connection_cap.hpp"
+
 #include <algorithm>
 #include <array>
 #include <stdexcept>
@@ -62,6 +64,8 @@ std::optional<Routed> receive_routed(zmq::socket_t& router, std::chrono::microse
   routed.peer = parts.front().to_string();
   routed.well_framed = parts.size() == 2;
   if (parts.size() >= 2) routed.payload = parts[1].to_string();
+  // The connection's descriptor; -1 without one (inproc; cppzmq's get() would throw).
+  routed.source_fd = zmq_msg_get(parts.back().handle(), ZMQ_SRCFD);
   return routed;
 }
 
@@ -104,22 +108,35 @@ class ZmqLink final : public Link {
 class ZmqRouter final : public Router {
  public:
   explicit ZmqRouter(zmq::context_t& context) : socket_(context, zmq::socket_type::router) {}
+  ~ZmqRouter() override { cap_.reset(); }  // stops watching before the socket closes
   void guard(std::unique_ptr<ZapAuthenticator> zap) { zap_ = std::move(zap); }
+  void limit(std::unique_ptr<ConnectionCap> cap) { cap_ = std::move(cap); }
   zmq::socket_t& socket() { return socket_; }
   void bind(const std::string& endpoint) {
     socket_.bind(endpoint);
     bound_ = socket_.get(zmq::sockopt::last_endpoint);
   }
 
-  std::optional<Routed> receive(std::chrono::microseconds timeout) override { return receive_routed(socket_, timeout); }
+  std::optional<Routed> receive(std::chrono::microseconds timeout) override {
+    auto routed = receive_routed(socket_, timeout);
+    // A message under a side's routing id: its connection is not a stranger's
+    // to be dropped at the cap (with CURVE only the sides get a message through).
+    if (routed && cap_ && is_side_routing_id(routed->peer)) cap_->admit(routed->source_fd);
+    return routed;
+  }
   void send(const std::string& peer, const protocol::Envelope& envelope) override {
     send_routed(socket_, peer, envelope);
   }
   std::string endpoint() const override { return bound_; }
 
  private:
+  static bool is_side_routing_id(const std::string& peer) {
+    return peer == "solid" || peer == "fluid" || peer == "solid.hb" || peer == "fluid.hb";
+  }
+
   std::unique_ptr<ZapAuthenticator> zap_;  // tcp with CURVE; before socket_: outlives it
   zmq::socket_t socket_;
+  std::unique_ptr<ConnectionCap> cap_;  // tcp: watches socket_
   std::string bound_;
 };
 
@@ -135,6 +152,22 @@ class ZmqTransport final : public Transport {
     if (security.curve) {
       router->guard(std::make_unique<ZapAuthenticator>(context_, security.curve->client_public, security.refused));
       make_curve_server(socket, security.curve->server_secret);
+    } else if (endpoint.rfind("tcp://", 0) == 0) {
+      // Plain tcp: a ZAP domain (with no handler, so every peer is admitted)
+      // makes ZeroMQ refuse ZMTP 1.0 and 2.0 peers at the greeting. libzmq
+      // 4.3.4 aborts the process (errno_assert, zmtp_engine.cpp:446) when
+      // such a peer's first frame, its routing id, completes while the
+      // socket is being closed; the sides all speak ZMTP 3
+      // (docs/reliability.md, "The libzmq abort").
+      socket.set(zmq::sockopt::zap_domain, std::string("hfmpm"));
+    }
+    if (endpoint.rfind("tcp://", 0) == 0) {
+      // A long listen queue: a side's connection that arrives amid a flood
+      // waits in it for the next accept() instead of having its SYN dropped
+      // (the kernel retries a dropped SYN after 1 s, then 3 s).
+      socket.set(zmq::sockopt::backlog, kListenBacklog);
+      router->limit(
+          std::make_unique<ConnectionCap>(context_, socket, connection_cap_for_this_process(), security.refused));
     }
     router->bind(endpoint);
     return router;

@@ -177,6 +177,86 @@ TEST(Failure, SidesDieWithAKilledCoupler) {
   EXPECT_GE(read_csv(out + "/history.csv").rows.size(), 1u);
 }
 
+// A coupler killed with SIGKILL cannot write anything: its run.json stays at
+// "running". The next hfmpm that reads the directory (hfmpm status, hfmpm run
+// --restart) finds the recorded coupler gone and records the run as stopped.
+TEST(Failure, AKilledCouplerIsRecordedByTheNextHfmpm) {
+  const auto out = scratch_dir("coupler-killed");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  Process coupler({bin("hfmpm"), "run", scene, "--out", out, "--quiet"});
+  for (int i = 0; i < 500 && json_string(read_file(out + "/run.json"), "status") != "running"; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_EQ(json_string(read_file(out + "/run.json"), "status"), "running");
+  const std::string pid = std::to_string(coupler.pid());
+
+  // While it runs: reported as running, with its pid; run.json untouched; no restart.
+  const auto live = run({bin("hfmpm"), "status", out}, 20);
+  EXPECT_EQ(live.exit_code, 0) << live.err;
+  EXPECT_NE(live.out.find(": running (coupler pid " + pid + " on "), std::string::npos) << live.out;
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "running");
+  const auto restart_live = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 20);
+  EXPECT_EQ(restart_live.exit_code, 2);
+  EXPECT_NE(restart_live.err.find("is still running (coupler pid " + pid), std::string::npos) << restart_live.err;
+  EXPECT_TRUE(coupler.running()) << "the refused restart left the run alone";
+
+  ASSERT_EQ(kill(coupler.pid(), SIGKILL), 0);
+  ASSERT_TRUE(coupler.wait(5));
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "running") << "SIGKILL leaves it as it was";
+
+  const auto found = run({bin("hfmpm"), "status", out}, 20);
+  EXPECT_EQ(found.exit_code, 0) << found.err;
+  EXPECT_NE(found.out.find("stopped without finishing (coupler killed?): run.json said \"running\", but its coupler "
+                           "(pid " +
+                           pid + ") no longer exists"),
+            std::string::npos)
+      << found.out;
+  const std::string manifest = read_file(out + "/run.json");
+  EXPECT_EQ(json_string(manifest, "status"), "stopped without finishing (coupler killed?)");
+  EXPECT_EQ(json_string(manifest, "status_before_check"), "running");
+  EXPECT_NE(json_string(manifest, "stopped_reason").find("no longer exists"), std::string::npos) << manifest;
+  EXPECT_EQ(json_number(manifest, "coupler_pid"), static_cast<double>(coupler.pid())) << "the rest is kept";
+  EXPECT_GE(read_csv(out + "/history.csv").rows.size(), 1u);
+  // Recorded: the next reader sees a final status.
+  const auto again = run({bin("hfmpm"), "status", out}, 20);
+  EXPECT_EQ(again.out, out + ": stopped without finishing (coupler killed?)\n") << again.out;
+
+  // A pid that now belongs to another process (this test, started at another
+  // time than the start time recorded) is not the run's coupler.
+  std::string text = read_file(out + "/run.json");
+  auto set_field = [&](const std::string& key, const std::string& value) {
+    const auto at = text.find("\"" + key + "\": ");
+    ASSERT_NE(at, std::string::npos) << key;
+    const auto end = text.find_first_of(",\n", at);
+    text.replace(at, end - at, "\"" + key + "\": " + value);
+  };
+  set_field("status", "\"running\"");
+  set_field("coupler_pid", std::to_string(getpid()));
+  set_field("coupler_start_ticks", "\"1\"");
+  write_file(out + "/run.json", text);
+  const auto reused = run({bin("hfmpm"), "status", out}, 20);
+  EXPECT_NE(reused.out.find("pid " + std::to_string(getpid()) + " is now another process"), std::string::npos)
+      << reused.out;
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "stopped without finishing (coupler killed?)");
+
+  // On another host it cannot tell, and says so without changing anything.
+  text = read_file(out + "/run.json");
+  set_field("status", "\"running\"");
+  set_field("coupler_host", "\"elsewhere.example\"");
+  write_file(out + "/run.json", text);
+  const auto other = run({bin("hfmpm"), "status", out}, 20);
+  EXPECT_NE(other.out.find("running according to run.json, but its coupler ran on elsewhere.example"),
+            std::string::npos)
+      << other.out;
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "running");
+
+  // No run.json: a clear error.
+  const auto none = run({bin("hfmpm"), "status", out + "/nothing"}, 20);
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.err.find("no run.json in this directory"), std::string::npos) << none.err;
+}
+
 // Sides started by hand (not children of the coupler) notice its silence.
 TEST(Failure, HandStartedSidesExitWhenTheCouplerGoesSilent) {
   const auto out = scratch_dir("silent");

@@ -136,6 +136,10 @@ TEST(Restart, AfterKillNineEqualsTheUninterruptedRun) {
 
   const auto restarted = run({bin("hfmpm"), "run", "--restart", b, "--quiet"}, 120);
   ASSERT_EQ(restarted.exit_code, 0) << restarted.err;
+  // The killed run's run.json said "running"; the restart found its coupler gone and says so.
+  EXPECT_NE(restarted.err.find("stopped without finishing (coupler killed?): its coupler (pid"), std::string::npos)
+      << restarted.err;
+  EXPECT_EQ(json_string(read_file(b + "/run.json"), "previous_status"), "stopped without finishing (coupler killed?)");
 
   // history.csv: the same rows (none twice, none missing) and values, but the wall clock.
   expect_same_history(read_csv(a + "/history.csv"), read_csv(b + "/history.csv"));
@@ -202,6 +206,51 @@ TEST(Restart, ImplicitAndJacobiSchemesContinueBitForBit) {
        "output.interval_s=0.05", "--set", "output.checkpoint_interval_s=0.06", "--set", "output.exchange_log=true",
        "--set", "coupling.scheme=JACOBI", "--set", "coupling.exchange_interval=2"},
       dir + "/jacobi");
+}
+
+// `hfmpm coupler --restart DIR` with the sides started by hand: the coupler
+// continues from its checkpoint, each side reads its own file under its output
+// directory (here the coupler's, from the Welcome), and the run ends as the
+// uninterrupted one did.
+TEST(Restart, CouplerWithSidesStartedByHandContinues) {
+  const auto dir = scratch_dir("restart-join");
+  const std::string a = dir + "/a", b = dir + "/b";
+  auto argv = run_args(a);
+  argv[std::find(argv.begin(), argv.end(), "time.end_s=0.4") - argv.begin()] = "time.end_s=0.2";
+  argv[std::find(argv.begin(), argv.end(), "output.checkpoint_interval_s=0.15") - argv.begin()] =
+      "output.checkpoint_interval_s=0.06";
+  const auto whole = run(argv, 120);
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  const auto steps = complete_checkpoints(a);
+  ASSERT_EQ(steps.size(), 2u);
+  fs::copy(a, b, fs::copy_options::recursive);
+  std::ostringstream last;
+  last << b << "/checkpoints/step-" << std::setw(12) << std::setfill('0') << steps.back();
+  fs::remove_all(last.str());
+
+  const std::string endpoint = "ipc://" + dir + "/control";
+  Process coupler({bin("hfmpm"), "coupler", "--restart", b, "--bind", endpoint, "--quiet"});
+  Process solid({bin("hfmpm-solid"), "--connect", endpoint});
+  Process fluid({bin("hfmpm-fluid"), "--connect", endpoint});
+  ASSERT_TRUE(coupler.wait(120));
+  EXPECT_EQ(coupler.exit_code(), 0) << coupler.err();
+  EXPECT_TRUE(solid.wait(10));
+  EXPECT_TRUE(fluid.wait(10));
+  EXPECT_EQ(solid.exit_code(), 0) << solid.err();
+  const std::string manifest = read_file(b + "/run.json");
+  EXPECT_EQ(json_string(manifest, "status"), "completed");
+  EXPECT_EQ(json_number(manifest, "restart_step"), static_cast<double>(steps.front()));
+  EXPECT_EQ(json_string(manifest, "previous_status"), "completed");
+  expect_same_history(read_csv(a + "/history.csv"), read_csv(b + "/history.csv"));
+  std::size_t datasets = 0;
+  expect_same_frames(a + "/solid.h5", b + "/solid.h5", datasets);
+  expect_same_frames(a + "/fluid.h5", b + "/fluid.h5", datasets);
+  EXPECT_GT(datasets, 100u);
+
+  // --restart is for run and coupler only.
+  const auto validate = run({bin("hfmpm"), "validate", "--restart", b}, 20);
+  EXPECT_EQ(validate.exit_code, 2);
+  EXPECT_NE(validate.err.find("--restart is for 'hfmpm run' and 'hfmpm coupler'"), std::string::npos) << validate.err;
 }
 
 TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {

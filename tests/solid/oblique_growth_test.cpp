@@ -343,7 +343,7 @@ TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {
 // The inclined centre crack (45 degrees) under remote tension sigma_yy grows
 // on past its first kink. Maximum hoop stress with the handbook K_I = K_II
 // kinks it by -53.13 deg (heading -8.13 deg from the x axis at the end tip;
-// InclinedCrack.MixedModeAndKinkAngle checks the angle before growth); the
+// InclinedCrack.MixedModeAndKinkAngleThenNoSecondKink checks the angle before growth); the
 // kinked crack then carries a small K_II that turns it towards the plane
 // normal to the load (heading 0 at the end tip, 180 at the start tip), the
 // path's asymptote. Plate +-5a (K about 4% above the infinite plate's); the

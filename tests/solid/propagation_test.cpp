@@ -254,3 +254,102 @@ TEST(Propagation, CrackInStiffLayerTurnsTowardsSoftLayer) {
 
 }  // namespace
 }  // namespace hfmpm::solid::mpm
+
+namespace hfmpm::solid::mpm {
+namespace {
+
+// A crack grown to a length must open as a crack cut at that length from the
+// start: the static state of a linear-elastic body does not depend on how its
+// crack got there. The edge crack above (h = W/20, tension at half the onset
+// load, so J stays below J_Ic) is grown from a = 0.3 W by four half-cell
+// steps to 0.4 W (growth forced through the zero-lag wait) and compared,
+// after 20 damped transits, with a crack cut at 0.4 W. Two openings per crack
+// particle: the crack particles' surfaces (what the fluid sees) and the
+// material's, the displacement of the nearest particle on each side
+// extrapolated to the crack particle with its displacement gradient.
+// Compared from 1.5 cells behind the tip (the grown part is the last two
+// cells; the particle half a cell from the tip is left out). Measured (3
+// December), grown / cut at 2, 1.5 cells: on a node row the material 1.0005,
+// 0.994 and the surfaces 1.000, 0.84 (and 0.93 at 2.5 cells: the surfaces
+// drift where the body is right); between node rows, where the KGD scenes
+// put their cracks, the material 0.885, 0.964 and the surfaces 0.82, 0.81
+// (0.78, 0.65 nearer the tip), and the particles beside the grown faces keep
+// stresses of +-2 MPa (three times the remote tension) that the cut crack's
+// do not: the across-the-crack node fields are light (an 8th of a node), and
+// their equilibrium leaves the stresses of the first particle rows free, so
+// the static state remembers the uncut body. docs/verification.md ("What
+// limits the KGD length"). Disabled: it fails (the surfaces on a node row,
+// both openings between node rows: open, issue 17) and takes about 2
+// minutes; run with --gtest_also_run_disabled_tests.
+struct OpeningProfile {
+  std::vector<double> x, surfaces, material;
+};
+
+OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows) {
+  constexpr double kW = 1, kH = 1.5, kFinal = 0.4;
+  const double sigma =
+      0.5 * std::sqrt(kRock.plane_strain_modulus() * 500) / (tada_edge_factor(0.3 / kW) * std::sqrt(kPi * 0.3));
+  const double transit = 2 * kH / kRock.p_wave_speed(kRock.density);
+  auto config = edge_crack(kW, a, kH, 20, TimeFunction::constant(sigma));
+  const double h = config.grid.h;
+  if (between_rows) {
+    config.grid.origin.y() -= 0.5 * h;
+    config.grid.ny += 1;
+  }
+  config.materials[0].toughness = 1;  // growth is held by the fluid front alone
+  config.fracture.propagate = grow;
+  config.fracture.check_interval = 5;
+  config.fracture.max_lag_cells = 0;
+  config.fracture.straight = true;
+  config.fracture.growth_cells = 0.5;
+  Solver solid(config);
+  const double dt = solid.stable_dt();
+  while (solid.time() < 25 * transit) {
+    const double tip = solid.cracks()[0].plane().back().x();
+    const bool may_grow = grow && tip < kFinal - 0.1 * h && solid.time() > 5 * transit;
+    solid.set_crack_front(0, may_grow ? tip : 0.0);
+    solid.step(dt);
+  }
+  OpeningProfile out;
+  const auto& crack = solid.cracks()[0];
+  const auto& p = solid.particles();
+  for (std::size_t k = 0; k < crack.size(); ++k) {
+    const Vec2 xk = crack.plane()[k];
+    Vec2 u[2] = {Vec2::Zero(), Vec2::Zero()};
+    double nearest[2] = {1e9, 1e9};
+    for (std::size_t q = 0; q < p.x.size(); ++q) {
+      const Vec2 d = p.x[q] - xk;
+      if (std::abs(d.x()) > 0.6 * h || std::abs(d.y()) > h) continue;
+      const int side = d.y() > 0 ? 0 : 1;
+      if (d.norm() < nearest[side]) {
+        nearest[side] = d.norm();
+        u[side] = p.displacement[q] + p.grad_u[q] * (xk - p.x[q]);
+      }
+    }
+    out.x.push_back(xk.x());
+    out.surfaces.push_back(crack.width(k));
+    out.material.push_back((u[0] - u[1]).y());
+  }
+  return out;
+}
+
+TEST(Propagation, DISABLED_GrownCrackOpensAsACrackCutAtThatLength) {
+  for (const bool between_rows : {false, true}) {
+    const auto cut = edge_crack_opening(0.4, false, between_rows);
+    const auto grown = edge_crack_opening(0.3, true, between_rows);
+    ASSERT_EQ(cut.x.size(), grown.x.size());
+    const double h = 1.0 / 20, tip = cut.x.back();
+    std::printf("%s: x, grown/cut opening (surfaces, material)\n",
+                between_rows ? "between node rows" : "on a node row");
+    for (std::size_t k = 1; k + 1 < cut.x.size(); ++k) {
+      const double rs = grown.surfaces[k] / cut.surfaces[k], rm = grown.material[k] / cut.material[k];
+      std::printf("  %.4f %.4f %.4f\n", cut.x[k], rs, rm);
+      if (tip - cut.x[k] < 1.5 * h - 1e-9) continue;  // the particle next to the tip
+      EXPECT_NEAR(rm, 1, 0.02) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
+      EXPECT_NEAR(rs, 1, 0.02) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hfmpm::solid::mpm

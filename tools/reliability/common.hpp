@@ -101,6 +101,15 @@ int kill_command(int trials, const CommonOptions& options);
 int fuzz_command(std::uint64_t messages, const CommonOptions& options);
 int bad_scenes_command(const CommonOptions& options);
 int restart_command(int trials, const CommonOptions& options);
+struct FloodOptions {
+  int fd_limit = 0;           // > 0: the coupler runs under `ulimit -n fd_limit`
+  bool insecure_tcp = false;  // the coupler on plain tcp (--insecure-tcp), not CURVE
+  bool old_zmtp = false;      // each connection sends a ZMTP 1.0 routing id; connections churn
+  int teardowns = 0;          // > 0: that many couplers no side joins, torn down under the flood
+  std::string bin_dir;        // the programs from here instead of this build's
+  double max_join_s = 0;      // > 0: a join under the flood slower than this is a problem
+};
+int flood_command(std::uint64_t connections, const FloodOptions& flood, const CommonOptions& options);
 
 // The end of a command: prints OK or PROBLEMS FOUND, removes `root` when all
 // is well (unless --keep), else says where the outputs are; the exit status.

@@ -52,6 +52,9 @@ struct RunOptions {
   // Continue from this checkpoint (hfmpm run --restart): output_dir must be its
   // run directory, and the scene its scene (check_restart_scene).
   std::shared_ptr<const RestartPoint> restart;
+  // The continued run's status as the restart found it (run.json's
+  // "previous_status"), e.g. "stopped without finishing (coupler killed?)".
+  std::string previous_status;
 };
 
 struct RunSummary {

@@ -56,6 +56,7 @@ struct Routed {
   std::string peer;
   std::string payload;
   bool well_framed = true;  // exactly [routing id][payload]
+  int source_fd = -1;       // ZeroMQ over tcp/ipc: the connection's descriptor (ZMQ_SRCFD), else -1
 };
 
 // The coupler's end of the control plane: every side connects its control
@@ -71,6 +72,9 @@ class Router {
 
 // Who may join the coupler on tcp: CURVE with the coupler's secret key, and
 // only peers presenting the sides' public key (docs/reliability.md).
+// On tcp, the connections of peers that have not yet sent a side's message
+// are capped (docs/reliability.md, "A cap on connections"); `refused` also
+// hears about connections closed beyond the cap.
 struct RouterSecurity {
   std::optional<CurveKeys> curve;
   std::function<void(const std::string&)> refused;  // told about refused peers (another thread)

@@ -33,6 +33,10 @@ inline constexpr std::int64_t kSideControlMaxMessageBytes = std::int64_t{64} << 
 // holds a descriptor for at most this long.
 inline constexpr int kHandshakeMs = 5000;
 
+// The coupler's tcp listen queue (ZMQ_BACKLOG; ZeroMQ's default is 100; the
+// kernel caps it at net.core.somaxconn, 4096 by default).
+inline constexpr int kListenBacklog = 1024;
+
 // A Transport over a ZeroMQ context of its own (one I/O thread).
 std::shared_ptr<Transport> make_zmq_transport();
 

@@ -1,0 +1,44 @@
+// Is the run in a directory still going? run.json names the coupler that
+// writes it (coupler_pid, coupler_host, coupler_start_ticks, boot_id); a
+// coupler killed with SIGKILL (or a machine that went down) leaves run.json at
+// "starting" or "running". The next `hfmpm` that reads the directory
+// (`hfmpm status DIR`, `hfmpm run --restart DIR`) checks whether that
+// process still exists and records the run as stopped when it does not
+// (docs/reliability.md, "A coupler killed with SIGKILL").
+#pragma once
+
+#include <sys/types.h>
+#include <cstdint>
+#include <string>
+
+namespace hfmpm::coupling {
+
+// What run.json's status becomes when its coupler is found gone.
+inline constexpr const char* kStoppedWithoutFinishing = "stopped without finishing (coupler killed?)";
+
+// /proc/PID/stat's start time (clock ticks after boot), 0 if there is no such process.
+std::uint64_t process_start_ticks(pid_t pid);
+// /proc/sys/kernel/random/boot_id: changes at every boot ("" if unreadable).
+std::string boot_id();
+
+struct RunState {
+  enum class Coupler {
+    finished,    // the status is a final one (completed, failed, interrupted, ...)
+    alive,       // the recorded coupler is running on this host
+    gone,        // on this host, and no such process (or another one with its pid)
+    other_host,  // recorded on another host: cannot tell from here
+  };
+  std::string status;  // run.json's status, as found (before any update)
+  Coupler coupler = Coupler::finished;
+  long pid = 0;
+  std::string host, started_at;
+  std::string detail;  // why `gone` or `other_host`, for a message
+};
+
+// Reads DIR/run.json; throws std::runtime_error naming the file if it is
+// missing or has no status. `record`: a run whose coupler is gone gets
+// status kStoppedWithoutFinishing in run.json (the status it had goes to
+// "status_before_check", and "stopped_found_at" says when it was noticed).
+RunState check_run_state(const std::string& run_dir, bool record);
+
+}  // namespace hfmpm::coupling
