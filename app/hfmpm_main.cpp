@@ -264,8 +264,10 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     std::string text;
     google::protobuf::TextFormat::PrintToString(filled, &text);
     double particles = 0;  // the MPM solid's own count (regions may overlap)
-    if (filled.solid().has_mpm())
-      particles = solid::mpm::Solver(solid::to_solid_config(filled.solid().mpm())).particles().size();
+    if (filled.solid().has_mpm()) {
+      const solid::mpm::Solver solver(solid::to_solid_config(filled.solid().mpm()));
+      particles = static_cast<double>(solver.particles().size());
+    }
     std::cout << "# " << scene_path << ": valid\n"
               << coupling::describe(coupling::estimate_run_cost(filled, particles)) << text;
     return 0;
