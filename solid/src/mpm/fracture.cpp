@@ -1,5 +1,5 @@
 // Fracture mechanics at the crack tips: J-integral, stress intensity factors,
-// growth direction and propagation.
+// growth direction (propagation itself: growth.cpp).
 //
 // J is evaluated as an equivalent domain integral (Shih, Moran and Nakamura
 // 1986, Eng. Fract. Mech. 25; the area form of the contour integral a few
@@ -67,10 +67,6 @@ namespace hfmpm::solid::mpm {
 namespace {
 
 constexpr double kForever = std::numeric_limits<double>::infinity();
-// Shortest spacing of crack particles that growth creates, in cells: the
-// opening the grid gives the faces is linear within a cell, so at most two
-// independent openings per cell (docs/solid.md, "Growth").
-constexpr double kMinSegmentCells = 0.5;
 
 // 1D plateau: 1 for r <= ri, linear to 0 at ro; value and d/dr.
 struct Ramp {
@@ -477,103 +473,6 @@ TipResult Solver::evaluate_tip(std::size_t c, bool at_end) const {
   tip.k2 = tip.modulus * (area.m2 + faces.m2) / 2;
   tip.kink = max_hoop_stress_kink(tip.k1, tip.k2);
   return tip;
-}
-
-// The energy release rate that can drive growth: J without the part of a
-// negative K_I, G = J (max(K_I, 0)^2 + K_II^2) / (K_I^2 + K_II^2). A crack
-// closed in compression (faces in contact, K_I < 0 from the residual
-// interpenetration) has no mode-I singularity, but J, a quadratic, counts
-// it: in a confined body (in-situ stress 1e5 Pa, J_Ic 1e-3 J/m^2) the closed
-// dry tip ahead of a fluid-filled notch then grew although it was shut.
-double growth_energy(const TipResult& tip, bool mode_one_only) {
-  const double k1 = std::max(0.0, tip.k1), sum = tip.k1 * tip.k1 + tip.k2 * tip.k2;
-  const double driving = k1 * k1 + (mode_one_only ? 0.0 : tip.k2 * tip.k2);
-  return sum > 0 ? tip.j * driving / sum : tip.j;
-}
-
-int Solver::propagate() {
-  last_tips_ = tips();
-  const double h = config_.grid.h;
-  int added = 0;
-  if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
-  // Each crack's length before this check grows any tip: the settling wait of
-  // its second tip must not count the growth of its first in the same check
-  // (it did, and the two tips of a point-symmetric crack grew at alternate
-  // checks).
-  std::vector<double> lengths;
-  for (const auto& crack : cracks_) lengths.push_back(arc_length(crack.plane()).back());
-  for (const auto& tip : last_tips_) {
-    const bool straight = config_.fracture.straight;
-    double& grown_at = grown_at_[tip.crack][tip.at_end ? 1 : 0];
-    if (config_.fracture.settle_transits > 0 && grown_at > -kForever) {
-      const double length = lengths[tip.crack];
-      const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
-      if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
-    }
-    if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
-    if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
-      // The front need not enter the tip segment (its faces close to nothing at
-      // the tip): the allowed lag is at least that segment.
-      const auto& plane = cracks_[tip.crack].plane();
-      const std::vector<double> arc = arc_length(plane);
-      const double dry = arc.back() - cracks_[tip.crack].wetted_length();
-      const double allowed = std::max(config_.fracture.max_lag_cells * h, arc.back() - arc[arc.size() - 2]);
-      if (dry > allowed * (1 + 1e-9)) continue;  // wait for the fluid (zero-lag closure)
-    }
-    const double kink = straight ? 0.0 : tip.kink;
-    const double c = std::cos(kink), s = std::sin(kink);
-    const Vec2 d(c * tip.direction.x() - s * tip.direction.y(), s * tip.direction.x() + c * tip.direction.y());
-    const Vec2 next = tip.position + config_.fracture.growth_cells * h * d;
-    // Stop a cell short of the body's edge: the crack has run through.
-    if ((next.array() < (body_lo_.array() + h)).any() || (next.array() > (body_hi_.array() - h)).any()) continue;
-    // The new particle's reference position (Crack::reference): the tip's,
-    // plus the step less the mean displacement gradient of the particles
-    // within a cell of it.
-    const Vec2 mid = 0.5 * (tip.position + next);
-    Eigen::Matrix2d gradient = Eigen::Matrix2d::Zero();
-    double count = 0;
-    for (std::size_t p = 0; p < particles_.size(); ++p) {
-      if ((particles_.x[p] - mid).squaredNorm() >= h * h) continue;
-      gradient += particles_.grad_u[p];
-      count += 1;
-    }
-    if (count > 0) gradient /= count;
-    auto& crack = cracks_[tip.crack];
-    const Vec2& tip_reference = tip.at_end ? crack.reference().back() : crack.reference().front();
-    const Vec2 reference = tip_reference + (Eigen::Matrix2d::Identity() - gradient) * (next - tip.position);
-    // Straight growth (mode I by symmetry, along the crack's own direction)
-    // lengthens a tip segment shorter than kMinSegmentCells instead of adding
-    // a new one, while the result stays within half a growth step of
-    // kMinSegmentCells (the plane's own motion makes segment lengths inexact):
-    // the faces' opening is linear within a cell, so crack particles closer
-    // than half a cell give the fluid pressure nodes whose differences the
-    // solid cannot resist (docs/solid.md, "Crack particles at least half a
-    // cell apart"). The moved tip particle stands for the material point at
-    // its new place, so its reference position moves with it by the same
-    // estimate a new particle there would get.
-    const auto& plane = crack.plane();
-    const std::size_t n = plane.size();
-    const double length = tip.at_end ? (plane[n - 1] - plane[n - 2]).norm() : (plane[0] - plane[1]).norm();
-    const double grown = length + config_.fracture.growth_cells * h;
-    if (straight && grown <= (kMinSegmentCells + 0.5 * config_.fracture.growth_cells) * h) {
-      crack.move_tip(tip.at_end, next, reference);
-    } else if (tip.at_end) {
-      crack.append(next, reference);
-    } else {
-      crack.prepend(next, reference);
-    }
-    grown_at = t_;
-    ++added;
-  }
-  return added;
-}
-
-// Feedback (Nose-Hoover) damping: d alpha / dt = (2 KE - 2 KE_target) / (M q).
-void Solver::update_feedback(double dt) {
-  const double ke = kinetic_energy();
-  const auto& d = config_.damping;
-  feedback_alpha_ += dt * 2 * (ke - d.feedback_target_ke) / (total_mass_ * d.feedback_q);
-  feedback_alpha_ = std::max(0.0, feedback_alpha_);
 }
 
 }  // namespace hfmpm::solid::mpm
