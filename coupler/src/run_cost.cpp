@@ -32,7 +32,9 @@ std::string number(double v, int digits = 3) {
 }
 
 std::string count(double v) {  // 12,345
-  std::string s = number(std::round(v), 15);
+  char b[64];
+  std::snprintf(b, sizeof b, "%.0f", v);  // whole digits at any size (%g would give 1e+16)
+  std::string s = b;
   for (int i = static_cast<int>(s.size()) - 3; i > 0; i -= 3) s.insert(static_cast<std::size_t>(i), ",");
   return s;
 }
