@@ -163,9 +163,13 @@ TEST(Sneddon, OpeningProfileMatchesAndConverges) {
 // stress as the reference state (SolidConfig::in_situ_reference): the
 // particles carry only the change of stress, the edges -sigma0 n on top of
 // their tractions and the faces p n + sigma0 n. By superposition the crack
-// must open as the plain case: the same 6% (L2) and 3% (mouth), and the same
-// profile to 0.5% (L2; measured: 4.82% in both, and with the in-situ stress
-// kept in the particles).
+// must open as the plain case: the same profile to 0.5% (L2) and the same
+// mouth opening and K_I. Superposition holds at any resolution, so this runs at
+// h = a/5 (an eighth of a/10's cost); the a/5 error bounds are those of the
+// convergence test's a/5 run (L2 9.7%, so held to 11%; mouth and K_I 3%).
+// Measured at a/5: L2 9.69% in both, mouth -1.38% in both, K_I +1.82% in both
+// (at a/10, before: 4.82% in both, also with the in-situ stress kept in the
+// particles).
 // Issue 19's near-tip drift: a soft material (p/E = 0.05, five hundred
 // times sneddon.scene's) with the crack on a node row, as here. The issue saw
 // the face point next to the tip open without bound through the run (to five
@@ -204,13 +208,13 @@ TEST(Sneddon, SoftMaterialOnANodeRowHasNoNearTipDrift) {
 
 TEST(Sneddon, InSituStressAsReferenceOpensAsTheNetPressure) {
   const double sigma0 = -10 * kP;
-  const auto plain = run_sneddon(10, 2);
-  const auto reference = run_sneddon(10, 2, sigma0, true);
+  const auto plain = run_sneddon(5, 2);
+  const auto reference = run_sneddon(5, 2, sigma0, true);
   std::printf(
-      "sneddon a/10: L2 error %.4f (no in-situ stress), %.4f (in-situ stress -10 p as reference); "
+      "sneddon a/5: L2 error %.4f (no in-situ stress), %.4f (in-situ stress -10 p as reference); "
       "mouth %+.4f, %+.4f; K_I %+.4f, %+.4f\n",
       plain.l2_error, reference.l2_error, plain.mouth_error, reference.mouth_error, plain.k_error, reference.k_error);
-  EXPECT_LT(reference.l2_error, 0.06);
+  EXPECT_LT(reference.l2_error, 0.11);
   EXPECT_LT(std::abs(reference.mouth_error), 0.03);
   EXPECT_LT(std::abs(reference.l2_error - plain.l2_error), 0.005);
   EXPECT_LT(std::abs(reference.k_error), 0.03);
@@ -221,18 +225,24 @@ TEST(Sneddon, InSituStressAsReferenceOpensAsTheNetPressure) {
 // (x < 2a, |y| < a) around the crack. The far field carries small, smooth
 // strains that one uGIMP particle per cell integrates well, so the opening
 // and K_I stay those of the fine body: the profile within 0.5% (L2 difference
-// of the errors) and K_I within 1%, with under half the particles (measured
-// below). The crack's own cells keep four particles each.
+// of the errors) and K_I within 1%, with under half the particles. Run at
+// h = a/5 (the crack's cells are the ones that matter and a/5 already resolves
+// the far field's strains): measured 5,000 against 1,550 particles, L2 error
+// 9.69% against 9.61%, mouth -1.38% against -1.11%, K_I +1.82% against +2.02%
+// (at a/10, before: 20,000 against 6,200; 4.82% both; +0.85/+0.94%; +2.36/+2.43%;
+// the coarse far field's departures are larger at a/5 but well inside the bounds).
+// The crack's own cells
+// keep four particles each.
 TEST(Sneddon, CoarseFarFieldOpensAsTheFineBody) {
-  const auto fine = run_sneddon(10, 2);
-  const auto coarse = run_sneddon(10, 2, 0, false, 2.0);
+  const auto fine = run_sneddon(5, 2);
+  const auto coarse = run_sneddon(5, 2, 0, false, 2.0);
   std::printf(
-      "sneddon a/10: %zu particles (fine), %zu (coarse far field); L2 error %.4f, %.4f; mouth %+.4f, %+.4f; "
+      "sneddon a/5: %zu particles (fine), %zu (coarse far field); L2 error %.4f, %.4f; mouth %+.4f, %+.4f; "
       "K_I %+.4f, %+.4f\n",
       fine.particles, coarse.particles, fine.l2_error, coarse.l2_error, fine.mouth_error, coarse.mouth_error,
       fine.k_error, coarse.k_error);
   EXPECT_LT(coarse.particles, fine.particles / 2);
-  EXPECT_LT(coarse.l2_error, 0.06);
+  EXPECT_LT(coarse.l2_error, 0.11);
   EXPECT_LT(std::abs(coarse.l2_error - fine.l2_error), 0.005);
   EXPECT_LT(std::abs(coarse.mouth_error - fine.mouth_error), 0.005);
   EXPECT_LT(std::abs(coarse.k_error - fine.k_error), 0.01);
