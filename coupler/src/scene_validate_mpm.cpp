@@ -230,6 +230,8 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   c.range(key + "fracture.growth_cells", f.growth_cells(), 0, 1, true, "cells");
   if (f.has_max_lag_cells()) c.range(key + "fracture.max_lag_cells", f.max_lag_cells(), 0, 1e3, false, "cells");
   c.range(key + "fracture.settle_transits", f.settle_transits(), 0, 1e3, false, "shear-wave transits of the crack");
+  c.range(key + "fracture.front_settle_transits", f.front_settle_transits(), 0, 1e3, false,
+          "shear-wave transits of the J domain");
   if (f.check_interval() < 1)
     c.bad(key + "fracture.check_interval", std::to_string(f.check_interval()), "at least 1 step");
   if (f.direction() == scene::FractureSpec::DIRECTION_UNSPECIFIED) {

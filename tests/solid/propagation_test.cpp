@@ -83,10 +83,13 @@ SolidConfig driven_edge_crack() {
 // fracture.max_lag_cells (the zero-lag closure of fluid-driven cracks): the
 // same edge crack under a load held at 1.5 sigma_c (J well above J_Ic) does
 // not grow while the fluid front reported on it lies more than max_lag_cells
-// cells behind the tip, and grows once the front is within that distance.
+// cells behind the tip, and grows once the front is within that distance
+// (at the next check: the settling wait after the front's arrival, tested
+// below, is off here).
 TEST(Propagation, TipWaitsForTheFluidFrontWithMaxLag) {
   auto config = driven_edge_crack();
   config.fracture.max_lag_cells = 0.5;
+  config.fracture.front_settle_transits = 0;
   Solver solid(config);
   const double h = solid.grid().h, dt = solid.stable_dt();
   const std::size_t initial = solid.cracks()[0].size();
@@ -185,6 +188,68 @@ TEST(Propagation, GrownTipWaitsSettleTransitsBeforeGrowingAgain) {
     EXPECT_GE(gap, wait - 1e-12);
     EXPECT_LE(gap, wait + 5 * dt2 + 1e-12);
   }
+}
+
+// front_settle_transits: with the zero-lag wait, a tip that kinks (maximum
+// hoop stress) grows only after 4 shear-wave transits of its J domain
+// (outer_cells h / c_s) have passed since the fluid front came within reach;
+// a straight tip grows at the first check. The edge crack above under
+// 1.5 sigma_c (J well above J_Ic from the start) with its fluid front held
+// at a tenth of the notch: no growth (the zero-lag wait). At t_a the front
+// moves to the tip: the kinking tip's first growth comes at least the wait
+// after t_a and at most the wait plus two check intervals (the arrival is
+// seen at the first check after t_a, growth at the first check after the
+// wait); without the wait, and for a straight tip, within one check interval.
+TEST(Propagation, KinkingTipWaitsForTheFieldAfterTheFluidFrontArrives) {
+  constexpr double kW = 1, kA = 0.3, kH = 1.5 * kW, kToughness = 500;
+  constexpr int kCheck = 5;
+  const double e_prime = kRock.plane_strain_modulus();
+  const double sigma_c = std::sqrt(e_prime * kToughness) / (tada_edge_factor(kA / kW) * std::sqrt(kPi * kA));
+  struct FirstGrowth {
+    double arrival = 0, growth = -1, dt = 0, wait = 0;
+  };
+  auto first_growth = [&](double settle, bool straight) {
+    auto config = edge_crack(kW, kA, kH, 20, TimeFunction::constant(1.5 * sigma_c));
+    config.materials[0].toughness = kToughness;
+    config.fracture.propagate = true;
+    config.fracture.check_interval = kCheck;
+    config.fracture.max_lag_cells = 0.5;
+    config.fracture.straight = straight;
+    config.fracture.front_settle_transits = settle;
+    Solver solid(config);
+    FirstGrowth out;
+    out.dt = solid.stable_dt();
+    out.wait = settle * config.fracture.outer_cells * config.grid.h / std::sqrt(kRock.shear_modulus() / kRock.density);
+    const double transit = 2 * kH / kRock.p_wave_speed(kRock.density);
+    const std::size_t size = solid.cracks()[0].size();
+    solid.set_crack_front(0, 0.1 * kA);
+    while (solid.time() < 2 * transit) solid.step(out.dt);
+    EXPECT_EQ(solid.cracks()[0].size(), size) << "grew with the front far behind the tip";
+    out.arrival = solid.time();
+    solid.set_crack_front(0, kA);
+    while (solid.time() < out.arrival + out.wait + 10 * kCheck * out.dt) {
+      solid.step(out.dt);
+      if (solid.cracks()[0].size() > size) {
+        out.growth = solid.time();
+        break;
+      }
+    }
+    return out;
+  };
+  const FirstGrowth waited = first_growth(4, false), eager = first_growth(0, false), straight = first_growth(4, true);
+  std::printf(
+      "first growth after the front's arrival: %.3e s kinking with the wait (wait %.3e s), %.3e s without, "
+      "%.3e s straight; check interval %.3e s\n",
+      waited.growth - waited.arrival, waited.wait, eager.growth - eager.arrival, straight.growth - straight.arrival,
+      kCheck * waited.dt);
+  ASSERT_GT(waited.wait, 10 * kCheck * waited.dt) << "the wait must span several checks to be seen";
+  ASSERT_GE(waited.growth, 0) << "the kinking tip never grew";
+  EXPECT_GE(waited.growth - waited.arrival, waited.wait - 1e-12);
+  EXPECT_LE(waited.growth - waited.arrival, waited.wait + 2 * kCheck * waited.dt + 1e-12);
+  ASSERT_GE(eager.growth, 0);
+  EXPECT_LE(eager.growth - eager.arrival, kCheck * eager.dt + 1e-12);
+  ASSERT_GE(straight.growth, 0);
+  EXPECT_LE(straight.growth - straight.arrival, kCheck * straight.dt + 1e-12);
 }
 
 // A pressurised edge crack in the stiffer of two bonded layers, parallel to

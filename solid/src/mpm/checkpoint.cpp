@@ -106,6 +106,7 @@ void Solver::save(StateWriter& out) const {
   std::vector<double> grown;
   for (const auto& g : grown_at_) grown.insert(grown.end(), g.begin(), g.end());
   out.put("grown_at", grown);
+  out.put("front_arrived_at", front_arrived_at_);
   std::vector<std::uint64_t> tip_crack, tip_end, tip_material;
   std::vector<Vec2> tip_position, tip_direction;
   std::vector<double> tip_j, tip_j_faces, tip_k1, tip_k2, tip_kink, tip_toughness, tip_modulus;
@@ -191,6 +192,7 @@ void Solver::load(const StateReader& in) {
   if (grown.size() % 2 != 0) throw std::runtime_error("checkpoint array grown_at has an odd size");
   grown_at_.resize(grown.size() / 2);
   for (std::size_t i = 0; i < grown_at_.size(); ++i) grown_at_[i] = {grown[2 * i], grown[2 * i + 1]};
+  in.get("front_arrived_at", front_arrived_at_);
   std::vector<std::uint64_t> tip_crack, tip_end, tip_material;
   std::vector<Vec2> tip_position, tip_direction;
   std::vector<double> tip_j, tip_j_faces, tip_k1, tip_k2, tip_kink, tip_toughness, tip_modulus;

@@ -37,6 +37,7 @@ int Solver::propagate() {
   const double h = config_.grid.h;
   int added = 0;
   if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
+  if (front_arrived_at_.size() != cracks_.size()) front_arrived_at_.resize(cracks_.size(), -kForever);
   // Each crack's length before this check grows any tip: the settling wait of
   // its second tip must not count the growth of its first in the same check
   // (it did, and the two tips of a point-symmetric crack grew at alternate
@@ -51,7 +52,6 @@ int Solver::propagate() {
       const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
       if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
     }
-    if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
     if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
       // The front need not enter the tip segment (its faces close to nothing at
       // the tip): the allowed lag is at least that segment.
@@ -59,8 +59,23 @@ int Solver::propagate() {
       const std::vector<double> arc = arc_length(plane);
       const double dry = arc.back() - cracks_[tip.crack].wetted_length();
       const double allowed = std::max(config_.fracture.max_lag_cells * h, arc.back() - arc[arc.size() - 2]);
-      if (dry > allowed * (1 + 1e-9)) continue;  // wait for the fluid (zero-lag closure)
+      double& arrived_at = front_arrived_at_[tip.crack];
+      if (dry > allowed * (1 + 1e-9)) {  // wait for the fluid (zero-lag closure)
+        arrived_at = -kForever;
+        continue;
+      }
+      // The front has come within reach: the fluid's pressure behind it (below
+      // the confining stress near a front) loads the faces near the tip at
+      // once, and the body needs a few shear-wave transits of the J domain to
+      // follow; K's read before that set a direction from a field that is not
+      // the one the load makes (docs/solid.md, "Growth"). A straight tip's
+      // direction does not depend on them: it does not wait.
+      if (arrived_at == -kForever) arrived_at = t_;
+      const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
+      const double domain = config_.fracture.outer_cells * h;
+      if (!straight && t_ - arrived_at < config_.fracture.front_settle_transits * domain / c_s) continue;
     }
+    if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
     const double kink = straight ? 0.0 : tip.kink;
     const double c = std::cos(kink), s = std::sin(kink);
     const Vec2 d(c * tip.direction.x() - s * tip.direction.y(), s * tip.direction.x() + c * tip.direction.y());
@@ -104,6 +119,7 @@ int Solver::propagate() {
       crack.prepend(next, reference);
     }
     grown_at = t_;
+    if (tip.at_end && tip.crack < front_arrived_at_.size()) front_arrived_at_[tip.crack] = -kForever;
     ++added;
   }
   return added;

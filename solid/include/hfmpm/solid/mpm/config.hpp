@@ -85,6 +85,13 @@ struct Fracture {
   // scaled density): the time the crack's opening needs to follow the new
   // length. 0: no wait.
   double settle_transits = 0;
+  // With the zero-lag closure (max_lag_cells >= 0 and a fluid front), for
+  // tips that kink (not straight): once the front has come within the
+  // allowed lag, the tip grows only after this many shear-wave transits of
+  // its J domain (outer_cells h / c_s) have passed, so that the K's that set
+  // its direction are read on the field the front's pressure has made.
+  // 0: grows at the first check.
+  double front_settle_transits = 4;
 };
 
 struct SolidConfig {

@@ -197,6 +197,9 @@ class Solver {
   SolidConfig config_;
   std::vector<TipResult> last_tips_;
   std::vector<std::array<double, 2>> grown_at_;  // s, last growth of each crack's (start, end) tip
+  // s, when the fluid front came within the end tip's allowed lag (-inf: not
+  // since its last growth); Fracture::front_settle_transits.
+  std::vector<double> front_arrived_at_;
   double feedback_alpha_ = 0;
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
