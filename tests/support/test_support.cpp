@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <regex>
 #include <sstream>
 #include <stdexcept>
@@ -50,6 +51,8 @@ std::string source(const std::string& relative) { return std::string(HFMPM_SOURC
 std::string scratch_dir(const std::string& name) {
   std::string pattern = "/tmp/hfmpm-test-" + name + "-XXXXXX";
   if (!mkdtemp(pattern.data())) throw std::runtime_error("mkdtemp failed");
+  static std::mutex registry;  // tests may start processes from several threads
+  const std::lock_guard<std::mutex> lock(registry);
   scratch_dirs().add(pattern);
   return pattern;
 }
