@@ -8,6 +8,7 @@
 #include <iostream>
 #include <map>
 
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/run_cost.hpp"
 #include "hfmpm/coupling/run_state.hpp"
@@ -19,6 +20,7 @@
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
+#include "solid_scene_rules.hpp"
 
 namespace {
 
@@ -234,8 +236,11 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     }
   }
   if (scene_path.empty() && !restart_point) throw UsageError("no scene file given");
+  // The coupler's validation with each side's rules for its block: this
+  // command links both sides, the coupler library neither.
+  const coupling::SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
   const scene::Scene scene =
-      scene_path.empty() ? restart_point->state.scene() : coupling::load_scene(scene_path, overrides);
+      scene_path.empty() ? restart_point->state.scene() : coupling::load_scene(scene_path, rules, overrides);
   if (restart_point) {
     try {
       coupling::check_restart_scene(*restart_point, scene);
@@ -269,7 +274,7 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       particles = static_cast<double>(solver.particles().size());
     }
     std::cout << "# " << scene_path << ": valid\n"
-              << coupling::describe(coupling::estimate_run_cost(filled, particles)) << text;
+              << coupling::describe(coupling::estimate_run_cost(filled, rules, particles)) << text;
     return 0;
   }
   if (!options.keys_file.empty() && command != "coupler") {

@@ -20,12 +20,14 @@
 #include <vector>
 #include <zmq.hpp>
 
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/process.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/runtime/transport.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
+#include "solid_scene_rules.hpp"
 
 namespace {
 
@@ -101,7 +103,7 @@ coupling::RunSummary run_case(const Case& c, int steps, const std::string& scene
       "coupling.exchange_interval=" + std::to_string(c.exchange_interval),
       "coupling.control_interval=" + std::to_string(c.control_interval),
   };
-  const auto scene = coupling::load_scene(scene_path, overrides);
+  const auto scene = coupling::load_scene(scene_path, {solid::scene_rules(), fluid::scene_rules()}, overrides);
   coupling::RunOptions options;
   options.output_dir = "/tmp/hfmpm-bench-coupling";
   options.progress = false;

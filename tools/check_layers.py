@@ -46,9 +46,9 @@ def folder_of_include(name):
             return folder
     if re.fullmatch(r"hfmpm/[a-z_]+\.(hpp|pb\.h)", name):
         return "proto"  # exchange.hpp, time_function.hpp, the generated messages
-    if name.endswith("_solid_side.hpp"):
+    if name.endswith("_solid_side.hpp") or name == "solid_scene_rules.hpp":
         return "solid/side"
-    if name.endswith("_fluid_side.hpp"):
+    if name.endswith("_fluid_side.hpp") or name == "fluid_scene_rules.hpp":
         return "fluid/side"
     return None
 

@@ -1,14 +1,11 @@
-// Run cost before a run: sizes and the step from the scene alone
-// (scene_size.cpp), wall time from throughputs measured on this project's
-// reference machine (docs/performance.md, "Water: the implicit interface
-// scheme's cost" and the quiet-machine table): kgd-viscosity, 10 s, 12,172
-// steps, quiet 2-core machine, 3 December.
+// Run cost before a run: sizes and the step from the scene alone (each
+// side's SceneSize and SceneStep, e.g. solid/side/scene_size.cpp), wall time from throughputs measured on this
+// project's reference machine (docs/performance.md, "Water: the implicit interface scheme's cost" and the quiet-machine
+// table): kgd-viscosity, 10 s, 12,172 steps, quiet 2-core machine, 3 December.
 #include "hfmpm/coupling/run_cost.hpp"
 
 #include <cmath>
 #include <cstdio>
-
-#include "scene_checker.hpp"
 
 namespace hfmpm::coupling {
 namespace {
@@ -51,24 +48,25 @@ std::string duration(double s) {
 
 }  // namespace
 
-RunCost estimate_run_cost(const scene::Scene& s, double particles) {
+RunCost estimate_run_cost(const scene::Scene& s, const proto::SceneRules& rules, double particles) {
   RunCost cost;
   double stable = 0;
-  if (s.solid().has_mpm()) {
-    const auto& m = s.solid().mpm();
-    cost.particles = particles > 0 ? particles : mpm_solid_particles(m);
-    cost.nodes = mpm_solid_nodes(m);
-    stable = mpm_solid_stable_dt(m);
-    cost.dt_from = "the MPM solid's stable step cfl h / c_p";
-  } else if (s.solid().has_prescribed_crack()) {
-    stable = s.solid().prescribed_crack().stable_dt_s();
-    cost.dt_from = "solid.prescribed_crack.stable_dt_s";
+  if (s.solid().model_case() != scene::Solid::MODEL_NOT_SET && rules.solid.stable_step) {
+    if (s.solid().has_mpm() && rules.solid.size) {
+      const auto size = rules.solid.size(s);
+      cost.particles = particles > 0 ? particles : size.particles;
+      cost.nodes = size.nodes;
+    }
+    const auto step = rules.solid.stable_step(s);
+    stable = step.dt_s;
+    cost.dt_from = step.source;
   }
-  if (s.has_fluid() && s.fluid().has_prescribed_pressure()) {
-    const double f = s.fluid().prescribed_pressure().stable_dt_s();
-    if (f > 0 && (!(stable > 0) || f < stable)) {
+  if (s.has_fluid() && s.fluid().model_case() != scene::Fluid::MODEL_NOT_SET && rules.fluid.stable_step) {
+    const auto step = rules.fluid.stable_step(s);
+    const double f = step.dt_s;
+    if (step.known && f > 0 && (!(stable > 0) || f < stable)) {
       stable = f;
-      cost.dt_from = "fluid.prescribed_pressure.stable_dt_s";
+      cost.dt_from = step.source;
     }
   }
   if (!(stable > 0) || !std::isfinite(stable)) return cost;

@@ -139,8 +139,7 @@ std::string describe(const SceneProblem& p, const std::string& name, int line,
     }
   }
   if (line > 0) where += ":" + std::to_string(line);
-  if (p.value.empty()) return where + ": " + p.key + " is missing; expected " + p.allowed;
-  return where + ": " + p.key + " = " + p.value + " is not allowed; expected " + p.allowed;
+  return where + ": " + proto::problem_text(p);
 }
 
 std::string quote(const std::string& value) {
@@ -214,7 +213,7 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
   }
 }
 
-scene::Scene parse_scene(const std::string& file_text, const std::string& name,
+scene::Scene parse_scene(const std::string& file_text, const std::string& name, const SceneRules& rules,
                          const std::vector<std::string>& overrides) {
   if (file_text.size() > kMaxSceneBytes) {
     throw SceneError({name + ": " + std::to_string(file_text.size()) + " bytes; a scene file may have at most " +
@@ -242,7 +241,7 @@ scene::Scene parse_scene(const std::string& file_text, const std::string& name,
     apply_override(scene, assignment);
     overridden.insert(assignment.substr(0, assignment.find('=')));
   }
-  const auto problems = validate(scene);
+  const auto problems = validate(scene, rules);
   if (!problems.empty()) {
     std::vector<std::string> lines;
     for (const auto& p : problems)
@@ -252,7 +251,7 @@ scene::Scene parse_scene(const std::string& file_text, const std::string& name,
   return scene;
 }
 
-scene::Scene load_scene(const std::string& path, const std::vector<std::string>& overrides) {
+scene::Scene load_scene(const std::string& path, const SceneRules& rules, const std::vector<std::string>& overrides) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) throw SceneError({path + ": is a directory, not a scene file"});
   std::ifstream in(path, std::ios::binary);
@@ -264,7 +263,7 @@ scene::Scene load_scene(const std::string& path, const std::vector<std::string>&
   }
   std::stringstream text;
   text << in.rdbuf();
-  return parse_scene(text.str(), path, overrides);
+  return parse_scene(text.str(), path, rules, overrides);
 }
 
 namespace {

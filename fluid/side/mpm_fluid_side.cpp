@@ -6,10 +6,12 @@
 #include <optional>
 #include <set>
 
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/fluid/mpm/solver.hpp"
 #include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/proto/scene_rules.hpp"
 
 namespace hfmpm::fluid {
 namespace {
@@ -18,6 +20,13 @@ class MpmFluidSide final : public coupling::SideModel {
  public:
   void setup(const scene::Scene& scene, const std::string& output_dir) override {
     if (!scene.fluid().has_mpm()) throw coupling::InputError("this side runs fluid.mpm scenes only");
+    // The side's own rules, as `hfmpm validate` applies them: a scene from
+    // another coupler is refused with the same messages.
+    if (const auto problems = proto::side_scene_problems(scene, scene_rules()); !problems.empty()) {
+      std::string message;
+      for (const auto& line : problems) message += (message.empty() ? "" : "\n") + line;
+      throw coupling::InputError(message);
+    }
     const auto& f = scene.fluid().mpm();
     config_ = to_fluid_config(f);
     config_.implicit_interface = scene.coupling().scheme() == scene::Coupling::IMPLICIT;

@@ -8,7 +8,9 @@
 #include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
+#include "hfmpm/proto/scene_rules.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
+#include "solid_scene_rules.hpp"
 
 namespace hfmpm::solid {
 namespace {
@@ -33,6 +35,13 @@ class MpmSolidSide final : public coupling::SideModel {
  public:
   void setup(const scene::Scene& scene, const std::string& output_dir) override {
     if (!scene.solid().has_mpm()) throw coupling::InputError("this side runs solid.mpm scenes only");
+    // The side's own rules, as `hfmpm validate` applies them: a scene from
+    // another coupler is refused with the same messages.
+    if (const auto problems = proto::side_scene_problems(scene, scene_rules()); !problems.empty()) {
+      std::string message;
+      for (const auto& line : problems) message += (message.empty() ? "" : "\n") + line;
+      throw coupling::InputError(message);
+    }
     try {
       solver_.emplace(to_solid_config(scene.solid().mpm()));
     } catch (const std::invalid_argument& e) {

@@ -11,8 +11,10 @@
 #include <iomanip>
 #include <sstream>
 
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/proto/envelope.hpp"
+#include "solid_scene_rules.hpp"
 
 namespace hfmpm::conformance {
 namespace {
@@ -75,7 +77,7 @@ Session::Session(Context& context, const LaunchOptions& options)
   if (config.tcp) overrides.emplace_back("coupling.transport=TCP");
   overrides.insert(overrides.end(), options.overrides.begin(), options.overrides.end());
   try {
-    scene_ = coupling::load_scene(config.scene_path, overrides);
+    scene_ = coupling::load_scene(config.scene_path, {solid::scene_rules(), fluid::scene_rules()}, overrides);
   } catch (const std::exception& e) {
     fail("the scene does not load: " + std::string(e.what()));
   }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "coupled_support.hpp"
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/runtime/memory_transport.hpp"
@@ -17,6 +18,7 @@
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
+#include "solid_scene_rules.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -42,11 +44,16 @@ coupling::RunSummary run_in_process(const scene::Scene& scene, const std::string
   return coupling::run_coupled(scene, options);
 }
 
+const coupling::SceneRules& rules() {
+  static const coupling::SceneRules both{solid::scene_rules(), fluid::scene_rules()};
+  return both;
+}
+
 // scenarios/kgd-viscosity-ci.scene cut to its first half second (a history
 // row every 0.1 s), as threads.
 scene::Scene small_kgd() {
   return coupling::load_scene(
-      source("scenarios/kgd-viscosity-ci.scene"),
+      source("scenarios/kgd-viscosity-ci.scene"), rules(),
       {"time.end_s=0.5", "output.interval_s=0.1", "output.hdf5=false", "coupling.transport=INPROC"});
 }
 
@@ -78,7 +85,7 @@ TEST(MemoryTransport, StandInsUnderEachSchemeAndIntervalAsOverZeroMq) {
     for (const std::string interval : {"1", "3"}) {
       SCOPED_TRACE(scheme + ", exchange_interval " + interval);
       const auto scene = coupling::parse_scene(
-          prescribed_scene(0.05), "prescribed",
+          prescribed_scene(0.05), "prescribed", rules(),
           {"coupling.transport=INPROC", "coupling.scheme=" + scheme, "coupling.exchange_interval=" + interval});
       const auto memory_out = scratch_dir("memory-standins-" + scheme + interval);
       const auto zmq_out = scratch_dir("memory-standins-zmq-" + scheme + interval);
@@ -93,7 +100,7 @@ TEST(MemoryTransport, StandInsUnderEachSchemeAndIntervalAsOverZeroMq) {
 }
 
 TEST(MemoryTransport, IsOnlyForSidesAsThreads) {
-  const auto scene = coupling::parse_scene(prescribed_scene(0.05), "prescribed", {"coupling.transport=IPC"});
+  const auto scene = coupling::parse_scene(prescribed_scene(0.05), "prescribed", rules(), {"coupling.transport=IPC"});
   const auto out = scratch_dir("memory-not-inproc");
   const auto summary = run_in_process(scene, out, std::make_shared<coupling::MemoryTransport>());
   EXPECT_FALSE(summary.ok);

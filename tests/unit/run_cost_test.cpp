@@ -7,16 +7,20 @@
 #include <cmath>
 #include <string>
 
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/run_cost.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
 #include "mpm_solid_side.hpp"
+#include "solid_scene_rules.hpp"
 
 namespace hfmpm::coupling {
 namespace {
 
+const SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
+
 scene::Scene scenario(const std::string& name) {
-  return with_defaults(load_scene(std::string(HFMPM_SOURCE_DIR) + "/scenarios/" + name + ".scene"));
+  return with_defaults(load_scene(std::string(HFMPM_SOURCE_DIR) + "/scenarios/" + name + ".scene", rules));
 }
 
 double solver_particles(const scene::Scene& s) {
@@ -31,7 +35,7 @@ TEST(RunCost, StepAndStepCountAreTheRunsOwn) {
   for (const auto& [name, steps] : {std::pair{"kgd-viscosity-ci", 8695.0}, std::pair{"kgd-viscosity", 12172.0}}) {
     const auto s = scenario(name);
     const solid::mpm::Solver solver(solid::to_solid_config(s.solid().mpm()));
-    const auto cost = estimate_run_cost(s);
+    const auto cost = estimate_run_cost(s, rules);
     EXPECT_NEAR(cost.dt, s.time().safety_factor() * solver.stable_dt(), 1e-12 * cost.dt) << name;
     EXPECT_EQ(cost.steps, steps) << name;
   }
@@ -44,8 +48,8 @@ TEST(RunCost, ParticlesAreTheSolversOrABoundAboveThem) {
   const auto s = scenario("kgd-viscosity-ci");
   const double exact = solver_particles(s);
   EXPECT_EQ(exact, 21536);  // the run's solid.h5 holds 21,536 particles
-  EXPECT_GE(estimate_run_cost(s).particles, exact);
-  EXPECT_EQ(estimate_run_cost(s, exact).particles, exact);
+  EXPECT_GE(estimate_run_cost(s, rules).particles, exact);
+  EXPECT_EQ(estimate_run_cost(s, rules, exact).particles, exact);
 }
 
 // The model is fitted to kgd-viscosity's quiet run (60.6 s). kgd-toughness,
@@ -57,10 +61,10 @@ TEST(RunCost, ParticlesAreTheSolversOrABoundAboveThem) {
 TEST(RunCost, WallTimeEstimateMatchesAMeasuredRunItWasNotFittedTo) {
   auto s = scenario("kgd-toughness");
   const double particles = solver_particles(s);
-  const auto explicit_cost = estimate_run_cost(s, particles);
+  const auto explicit_cost = estimate_run_cost(s, rules, particles);
   EXPECT_NEAR(explicit_cost.wall_s / 40.4, 1, 0.2) << explicit_cost.wall_s << " s";
   s.mutable_coupling()->set_scheme(scene::Coupling::IMPLICIT);
-  const auto implicit_cost = estimate_run_cost(s, particles);
+  const auto implicit_cost = estimate_run_cost(s, rules, particles);
   EXPECT_NEAR(implicit_cost.wall_s / 47.4, 1, 0.2) << implicit_cost.wall_s << " s";
   const std::string text = describe(implicit_cost);
   EXPECT_NE(text.find("12,172 steps"), std::string::npos) << text;
@@ -72,7 +76,7 @@ TEST(RunCost, WallTimeEstimateMatchesAMeasuredRunItWasNotFittedTo) {
 TEST(RunCost, UnknownStepIsSaidNotGuessed) {
   auto s = scenario("kgd-viscosity-ci");
   s.mutable_solid()->mutable_mpm()->set_cfl(0);  // invalid: the step cannot be known
-  const auto cost = estimate_run_cost(s);
+  const auto cost = estimate_run_cost(s, rules);
   EXPECT_EQ(cost.dt, 0);
   EXPECT_EQ(cost.wall_s, 0);
   EXPECT_NE(describe(cost).find("known only once the sides run"), std::string::npos);

@@ -1,7 +1,8 @@
 // Unit tests of the scene loader against hostile input: long tokens (no
 // regex on user input), names that escape the output directory, byte-order
 // marks, oversized input, every number finite, the crack geometry allowed,
-// the memory estimate (issue 22).
+// the memory estimate (issue 22), the MPM sides' own check of the scene in
+// their Welcome (issue 21).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -15,6 +16,9 @@
 #include <vector>
 
 #include "hfmpm/coupling/scene_loader.hpp"
+#include "hfmpm/proto/scene_rules.hpp"
+#include "mpm_fluid_side.hpp"
+#include "mpm_solid_side.hpp"
 #include "scene_test_support.hpp"
 
 namespace {
@@ -23,6 +27,7 @@ using hfmpm::coupling::SceneError;
 using hfmpm::test::data_path;
 using hfmpm::test::minimal_text;
 using hfmpm::test::scene_error;
+using hfmpm::test::side_rules;
 using hfmpm::test::with_overrides;
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -55,12 +60,12 @@ TEST(Hardening, LongUnknownKeyAndEnumValueInParserMessages) {
   const std::string key(50000, 'k');
   std::string text = minimal_text();
   text.replace(text.find("exchange_interval: 1"), 20, key + ": 1");
-  const auto e = scene_error([&] { hfmpm::coupling::parse_scene(text, "long.scene"); });
+  const auto e = scene_error([&] { hfmpm::coupling::parse_scene(text, "long.scene", side_rules()); });
   EXPECT_THAT(e.what(), HasSubstr("long.scene:9: unknown key '" + key + "' in Coupling; allowed: transport"));
   const std::string value(50000, 'U');
   std::string enum_text = minimal_text();
   enum_text.replace(enum_text.find("transport: IPC"), 14, "transport: " + value);
-  const auto f = scene_error([&] { hfmpm::coupling::parse_scene(enum_text, "enum.scene"); });
+  const auto f = scene_error([&] { hfmpm::coupling::parse_scene(enum_text, "enum.scene", side_rules()); });
   EXPECT_THAT(f.what(), HasSubstr("enum.scene:8:"));
   EXPECT_THAT(f.what(), HasSubstr(value));
 }
@@ -74,18 +79,19 @@ TEST(Hardening, DotNamesAreRefused) {
 }
 
 TEST(Hardening, Utf8ByteOrderMarkIsSkipped) {
-  const auto s = hfmpm::coupling::parse_scene("\xEF\xBB\xBF" + minimal_text(), "bom.scene");
+  const auto s = hfmpm::coupling::parse_scene("\xEF\xBB\xBF" + minimal_text(), "bom.scene", side_rules());
   EXPECT_EQ(s.name(), "minimal");
-  const auto e = scene_error([] { hfmpm::coupling::parse_scene("\xFF\xFEn\0a\0", "utf16.scene"); });
+  const auto e = scene_error([] { hfmpm::coupling::parse_scene("\xFF\xFEn\0a\0", "utf16.scene", side_rules()); });
   EXPECT_THAT(e.what(), HasSubstr("utf16.scene: the file is UTF-16"));
 }
 
 TEST(Hardening, OversizedInputIsRefused) {
   const auto e = scene_error([] { with_overrides({"description=" + std::string(100000, 'd')}); });
   EXPECT_THAT(e.what(), HasSubstr("an override may have at most 65536"));
-  const auto f = scene_error([] { hfmpm::coupling::parse_scene(std::string(17 << 20, ' '), "huge.scene"); });
+  const auto f =
+      scene_error([] { hfmpm::coupling::parse_scene(std::string(17 << 20, ' '), "huge.scene", side_rules()); });
   EXPECT_THAT(f.what(), HasSubstr("huge.scene: 17825792 bytes; a scene file may have at most"));
-  const auto g = scene_error([] { hfmpm::coupling::load_scene(data_path("bad_scenes")); });
+  const auto g = scene_error([] { hfmpm::coupling::load_scene(data_path("bad_scenes"), side_rules()); });
   EXPECT_THAT(g.what(), HasSubstr("is a directory"));
 }
 
@@ -127,7 +133,7 @@ TEST(Hardening, EveryDoubleFieldMustBeFinite) {
           r->SetDouble(m, field, bad);
         }
       }
-      const auto problems = hfmpm::coupling::validate(s);
+      const auto problems = hfmpm::coupling::validate(s, side_rules());
       ASSERT_EQ(problems.size(), 1u) << key;
       EXPECT_EQ(problems[0].key, key);
       EXPECT_THAT(problems[0].allowed, HasSubstr("finite")) << key;
@@ -141,7 +147,7 @@ TEST(Hardening, NonFiniteNumbersHideTheRulesTheyBreak) {
   // A NaN crack coordinate would also fail the geometry rules; only the NaN is reported.
   const auto e = scene_error([] {
     hfmpm::coupling::parse_scene(mpm_scene("cracks { x_m: [0, nan] y_m: [0.05, 0.05] start_is_tip: false }"),
-                                 "nan.scene");
+                                 "nan.scene", side_rules());
   });
   EXPECT_EQ(e.problems().size(), 1u) << e.what();
   EXPECT_THAT(e.what(), HasSubstr("solid.mpm.cracks[0].x_m[1] = nan is not allowed; expected a finite number: every "
@@ -150,31 +156,60 @@ TEST(Hardening, NonFiniteNumbersHideTheRulesTheyBreak) {
 
 TEST(Hardening, CrackGeometryThatIsAllowed) {
   // The base: an edge crack with its mouth on the body's edge and a symmetry line.
-  EXPECT_NO_THROW(hfmpm::coupling::parse_scene(mpm_scene(), "base.scene"));
+  EXPECT_NO_THROW(hfmpm::coupling::parse_scene(mpm_scene(), "base.scene", side_rules()));
   // Two cracks a cell and a half apart; the second interior with two tips.
   EXPECT_NO_THROW(hfmpm::coupling::parse_scene(
       mpm_scene("cracks { x_m: [0, 0.3] y_m: [0.05, 0.05] start_is_tip: false }\n"
                 "cracks { x_m: [0.35, 0.5, 0.7] y_m: [0.2, 0.25, 0.25] start_is_tip: true }"),
-      "two.scene"));
+      "two.scene", side_rules()));
   // A mouth on a polygon's inner edge (a notch), no symmetry line.
   EXPECT_NO_THROW(
       hfmpm::coupling::parse_scene(mpm_scene("cracks { x_m: [0.6, 0.6] y_m: [0.2, 0.6] start_is_tip: false }",
                                              "regions { material: \"rock\" polygon { x_m: [0, 1, 1, 0.2, 0.2, 1, 1, 0] "
                                              "y_m: [-1, -1, -0.2, -0.2, 0.2, 0.2, 1, 1] } }",
                                              ""),
-                                   "notch.scene"));
+                                   "notch.scene", side_rules()));
   // A mouth at the end of the polyline, on the body's right edge.
   EXPECT_NO_THROW(hfmpm::coupling::parse_scene(
-      mpm_scene("cracks { x_m: [0.5, 1] y_m: [0.05, 0.05] start_is_tip: true end_is_tip: false }"), "end.scene"));
+      mpm_scene("cracks { x_m: [0.5, 1] y_m: [0.05, 0.05] start_is_tip: true end_is_tip: false }"), "end.scene",
+      side_rules()));
 }
 
 TEST(Hardening, MemoryEstimateIsAgainstPhysicalMemory) {
-  EXPECT_GT(hfmpm::coupling::memory_limit_bytes(), 1e8);
-  const auto kgd = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity.scene"));
-  const double bytes = hfmpm::coupling::mpm_solid_memory_bytes(kgd.solid().mpm());
+  EXPECT_GT(hfmpm::solid::memory_limit_bytes(), 1e8);
+  const auto kgd = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity.scene"), side_rules());
+  const double bytes = hfmpm::solid::mpm_solid_memory_bytes(kgd.solid().mpm());
   // 129 x 260 nodes and about 48000 particles (1 per cell, 2 x 2 around the crack): tens of MB.
   EXPECT_GT(bytes, 1e7);
   EXPECT_LT(bytes, 2e8);
+}
+
+// A coupler other than hfmpm may hand a side a scene hfmpm would refuse: each
+// MPM side runs its own rules on its Welcome's scene and refuses it with the
+// words `hfmpm validate` uses (an input Error).
+TEST(Hardening, MpmSidesRefuseABadSceneInTheirWelcome) {
+  auto s = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity-ci.scene"), side_rules());
+  s.mutable_solid()->mutable_mpm()->set_cfl(0.7);
+  s.mutable_fluid()->mutable_mpm()->set_cfl(2);
+  const auto problems = hfmpm::coupling::validate(s, side_rules());
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].key, "solid.mpm.cfl");
+  EXPECT_EQ(problems[1].key, "fluid.mpm.cfl");
+  const auto refusal = [&](hfmpm::coupling::SideModel& side) -> std::string {
+    try {
+      side.setup(s, hfmpm::test::source("build/no-such-dir"));
+    } catch (const hfmpm::coupling::InputError& e) {
+      return e.what();
+    }
+    return "(accepted)";
+  };
+  EXPECT_EQ(refusal(*hfmpm::solid::make_mpm_solid_side()), hfmpm::proto::problem_text(problems[0]));
+  EXPECT_EQ(refusal(*hfmpm::fluid::make_mpm_fluid_side()), hfmpm::proto::problem_text(problems[1]));
+  const auto e = scene_error([] {
+    hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity-ci.scene"), side_rules(),
+                                {"solid.mpm.cfl=0.7"});
+  });
+  EXPECT_THAT(e.what(), HasSubstr(hfmpm::proto::problem_text(problems[0])));
 }
 
 }  // namespace

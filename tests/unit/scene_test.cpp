@@ -31,6 +31,7 @@ using hfmpm::coupling::SceneError;
 using hfmpm::test::data_path;
 using hfmpm::test::minimal_text;
 using hfmpm::test::scene_error;
+using hfmpm::test::side_rules;
 using hfmpm::test::with_overrides;
 using ::testing::HasSubstr;
 using ::testing::Not;
@@ -38,7 +39,7 @@ namespace scene = hfmpm::scene;
 
 // ------------------------------------------------------------ valid scenes
 TEST(SceneLoad, MinimalSceneLoadsWithSchemaDefaults) {
-  const auto s = hfmpm::coupling::load_scene(data_path("minimal.scene"));
+  const auto s = hfmpm::coupling::load_scene(data_path("minimal.scene"), side_rules());
   EXPECT_EQ(s.name(), "minimal");
   EXPECT_EQ(s.time().end_s(), 1.0);
   EXPECT_EQ(s.coupling().transport(), scene::Coupling::IPC);
@@ -46,7 +47,7 @@ TEST(SceneLoad, MinimalSceneLoadsWithSchemaDefaults) {
   EXPECT_EQ(s.solid().prescribed_crack().spacing_m(), 0.01);
   EXPECT_EQ(s.solid().prescribed_crack().profile(), scene::PrescribedCrack::ELLIPTIC);  // default
   EXPECT_EQ(s.fluid().prescribed_pressure().front_fraction(), 0.9);
-  EXPECT_TRUE(hfmpm::coupling::validate(s).empty());
+  EXPECT_TRUE(hfmpm::coupling::validate(s, side_rules()).empty());
   EXPECT_DOUBLE_EQ(hfmpm::coupling::output_interval(s), 0.01);  // interval_s 0: end_s / 100
 }
 
@@ -56,7 +57,7 @@ TEST(SceneLoad, EveryShippedScenarioLoads) {
     if (entry.path().extension() != ".scene") continue;
     ++count;
     EXPECT_NO_THROW({
-      const auto s = hfmpm::coupling::load_scene(entry.path().string());
+      const auto s = hfmpm::coupling::load_scene(entry.path().string(), side_rules());
       EXPECT_NE(s.solid().model_case(), hfmpm::scene::Solid::MODEL_NOT_SET) << entry.path();
     }) << entry.path();
   }
@@ -65,7 +66,7 @@ TEST(SceneLoad, EveryShippedScenarioLoads) {
 
 TEST(SceneLoad, MissingFileNamesThePath) {
   const std::string path = data_path("no_such_file.scene");
-  const auto e = scene_error([&] { hfmpm::coupling::load_scene(path); });
+  const auto e = scene_error([&] { hfmpm::coupling::load_scene(path, side_rules()); });
   EXPECT_THAT(e.what(), HasSubstr(path));
   EXPECT_THAT(e.what(), HasSubstr("cannot read"));
 }
@@ -73,7 +74,7 @@ TEST(SceneLoad, MissingFileNamesThePath) {
 TEST(SceneLoad, DryRunWithoutFluidIsValid) {
   std::string text = minimal_text();
   text = text.substr(0, text.find("fluid {"));
-  const auto s = hfmpm::coupling::parse_scene(text, "dry.scene");
+  const auto s = hfmpm::coupling::parse_scene(text, "dry.scene", side_rules());
   EXPECT_FALSE(s.has_fluid());
 }
 
@@ -141,7 +142,7 @@ TEST_P(BadSceneFile, IsRefusedWithFileLineKeyValueAndAllowedRange) {
   const BadScene& b = GetParam();
   const std::string path = data_path(std::string("bad_scenes/") + b.file + ".scene");
   ASSERT_TRUE(std::filesystem::exists(path)) << path;
-  const auto e = scene_error([&] { hfmpm::coupling::load_scene(path); });
+  const auto e = scene_error([&] { hfmpm::coupling::load_scene(path, side_rules()); });
   const std::string text = e.what();
   ASSERT_FALSE(e.problems().empty());
   if (b.line > 0) {
@@ -159,8 +160,8 @@ TEST_P(BadSceneFile, IsRefusedWithFileLineKeyValueAndAllowedRange) {
 TEST_P(BadSceneFile, ReportsExactlyOneProblem) {
   // Each file breaks one rule; a second message would be about a value the user did not get wrong.
   const BadScene& b = GetParam();
-  const auto e =
-      scene_error([&] { hfmpm::coupling::load_scene(data_path(std::string("bad_scenes/") + b.file + ".scene")); });
+  const auto e = scene_error(
+      [&] { hfmpm::coupling::load_scene(data_path(std::string("bad_scenes/") + b.file + ".scene"), side_rules()); });
   EXPECT_EQ(e.problems().size(), 1u) << e.what();
 }
 
@@ -208,7 +209,7 @@ TEST(BadScenes, EveryExpectationFileIsRefused) {
     if (expected.empty()) continue;
     ++count;
     SCOPED_TRACE(path);
-    const auto e = scene_error([&] { hfmpm::coupling::load_scene(path); });
+    const auto e = scene_error([&] { hfmpm::coupling::load_scene(path, side_rules()); });
     EXPECT_THAT(e.what(), HasSubstr(expected));
     EXPECT_EQ(e.problems().size(), 1u) << e.what();
     EXPECT_THAT(e.what(), HasSubstr(path + ":")) << "names the file";
@@ -220,7 +221,7 @@ TEST(Validate, ReportsEveryProblemNotOnlyTheFirst) {
   scene::Scene s;
   s.mutable_time()->set_end_s(-1);
   s.mutable_coupling()->set_exchange_interval(0);
-  const auto problems = hfmpm::coupling::validate(s);
+  const auto problems = hfmpm::coupling::validate(s, side_rules());
   std::vector<std::string> keys;
   for (const auto& p : problems) keys.push_back(p.key);
   EXPECT_THAT(keys, ::testing::IsSupersetOf({"time.end_s", "coupling.exchange_interval", "solid"}));
@@ -273,7 +274,7 @@ TEST(Override, MessageIsReplacedNotMerged) {
   const auto& f = s.solid().prescribed_crack().mouth_opening_m();
   EXPECT_EQ(f.kind_case(), scene::TimeFunction::kConstant);
   EXPECT_EQ(f.constant(), 0.002);
-  EXPECT_TRUE(hfmpm::coupling::validate(s).empty());
+  EXPECT_TRUE(hfmpm::coupling::validate(s, side_rules()).empty());
 }
 
 TEST(Override, UnknownKeyListsTheAllowedKeys) {
@@ -328,14 +329,16 @@ TEST(Override, ProblemsElsewhereStillNameTheFileLine) {
   // Override one key; a different bad key written in the file keeps its file:line.
   std::string text = minimal_text();
   text.replace(text.find("front_fraction: 0.9"), 19, "front_fraction: 2.0");
-  const auto e = scene_error([&] { hfmpm::coupling::parse_scene(text, "edited.scene", {"time.end_s=2"}); });
+  const auto e =
+      scene_error([&] { hfmpm::coupling::parse_scene(text, "edited.scene", side_rules(), {"time.end_s=2"}); });
   EXPECT_THAT(e.what(), HasSubstr("edited.scene:26: fluid.prescribed_pressure.front_fraction = 2"));
   EXPECT_THAT(e.what(), Not(HasSubstr("--set")));
 }
 
 TEST(Override, CanRepairAnInvalidFile) {
   const std::string text = hfmpm::test::read_file(data_path("bad_scenes/front_fraction_zero.scene"));
-  const auto s = hfmpm::coupling::parse_scene(text, "x.scene", {"fluid.prescribed_pressure.front_fraction=0.5"});
+  const auto s =
+      hfmpm::coupling::parse_scene(text, "x.scene", side_rules(), {"fluid.prescribed_pressure.front_fraction=0.5"});
   EXPECT_EQ(s.fluid().prescribed_pressure().front_fraction(), 0.5);
 }
 

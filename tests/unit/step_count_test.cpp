@@ -14,10 +14,12 @@
 
 #include <string>
 
+#include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
+#include "solid_scene_rules.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -40,7 +42,10 @@ hfmpm::coupling::RunSummary run_inproc(scene::Scene s, const std::string& name) 
   return summary;
 }
 
-scene::Scene minimal() { return hfmpm::coupling::load_scene(hfmpm::test::source("tests/data/minimal.scene")); }
+scene::Scene minimal() {
+  return hfmpm::coupling::load_scene(hfmpm::test::source("tests/data/minimal.scene"),
+                                     {hfmpm::solid::scene_rules(), hfmpm::fluid::scene_rules()});
+}
 
 TEST(StepCount, TooManyStepsFailTheRunNamingTheStepAndEndTime) {
   auto s = minimal();

@@ -28,9 +28,11 @@
 
 #include "common.hpp"
 #include "coupled_support.hpp"
+#include "fluid_scene_rules.hpp"
 #include "fuzz.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "messages.hpp"
+#include "solid_scene_rules.hpp"
 
 namespace hfmpm::reliability {
 
@@ -88,7 +90,8 @@ bool send_message(zmq::socket_t& socket, const Message& m) {
 
 MessageContext make_context(const std::string& dir) {
   MessageContext context;
-  context.coupled_scene = coupling::parse_scene(test::prescribed_scene(0.05, 0.01), "prescribed");
+  context.coupled_scene = coupling::parse_scene(test::prescribed_scene(0.05, 0.01), "prescribed",
+                                                {solid::scene_rules(), fluid::scene_rules()});
   context.dry_scene = context.coupled_scene;
   context.dry_scene.clear_fluid();
   context.data_endpoint = "ipc://" + dir + "/nobody";

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "hfmpm/proto/scene_rules.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {
@@ -19,10 +20,11 @@ struct RunCost {
   std::string basis;     // what the estimate assumes
 };
 
-// The estimate for a valid scene (call validate() first). `particles`: the
-// MPM solid's particle count if the caller made them (the scene alone gives
-// an upper bound that counts overlapping regions twice); 0 for that bound.
-RunCost estimate_run_cost(const scene::Scene& scene, double particles = 0);
+// The estimate for a valid scene (call validate() first), with the sides'
+// steps and sizes from `rules`. `particles`: the MPM solid's particle count
+// if the caller made them (the scene alone gives an upper bound that counts
+// overlapping regions twice); 0 for that bound.
+RunCost estimate_run_cost(const scene::Scene& scene, const proto::SceneRules& rules, double particles = 0);
 
 // The estimate as comment lines ("# ..."), for `hfmpm validate`.
 std::string describe(const RunCost& cost);

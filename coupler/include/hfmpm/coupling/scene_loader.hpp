@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "hfmpm/proto/scene_rules.hpp"
 #include "hfmpm/scene.pb.h"
 
 namespace hfmpm::coupling {
@@ -21,33 +22,28 @@ class SceneError : public std::runtime_error {
   std::vector<std::string> problems_;
 };
 
-// One value that breaks a rule: key path ("coupling.exchange_interval",
-// "solid.prescribed_crack.mouth_opening_m.table.t[2]"), its value as text
-// ("" if missing), and what is allowed.
-struct SceneProblem {
-  std::string key;
-  std::string value;
-  std::string allowed;
-};
+// One value that breaks a rule (key path, value as text, what is allowed).
+using proto::SceneProblem;
+// Each side's rules for its block of the scene (solid.*, fluid.*): the
+// coupler sees no side, so the program that links them hands them over
+// (app/: SceneRules{solid::scene_rules(), fluid::scene_rules()}).
+using proto::SceneRules;
 
-// Reads `path`, applies `overrides` ("key.path=value", in order), validates.
-scene::Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+// Reads `path`, applies `overrides` ("key.path=value", in order), validates
+// with the coupler's rules and the sides' `rules`.
+scene::Scene load_scene(const std::string& path, const SceneRules& rules,
+                        const std::vector<std::string>& overrides = {});
 // Same from text; `name` stands for the file in messages.
-scene::Scene parse_scene(const std::string& text, const std::string& name,
+scene::Scene parse_scene(const std::string& text, const std::string& name, const SceneRules& rules,
                          const std::vector<std::string>& overrides = {});
 
 // Sets one value by its dotted key path; throws SceneError for an unknown key
 // or a value of the wrong type. Repeated fields take "[a, b]" and are replaced.
 void apply_override(scene::Scene& scene, const std::string& assignment);
 
-// Every rule the scene breaks (empty if valid).
-std::vector<SceneProblem> validate(const scene::Scene& scene);
-
-// Rough memory the MPM solid needs for its grid and particles (bytes, from
-// the solver's per-node and per-particle arrays), and the most a scene may
-// ask for: 3/4 of this machine's physical memory (0 if unknown: no check).
-double mpm_solid_memory_bytes(const scene::MpmSolid& m);
-double memory_limit_bytes();
+// Every rule the scene breaks (empty if valid): the coupler's (name, time,
+// output, coupling, across both sides) and, in their place, the sides'.
+std::vector<SceneProblem> validate(const scene::Scene& scene, const SceneRules& rules);
 
 // Most steps a run may need to reach time.end_s (validation and the coupler).
 inline constexpr double kMaxRunSteps = 1e9;

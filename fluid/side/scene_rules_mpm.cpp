@@ -5,9 +5,15 @@
 #include <set>
 #include <vector>
 
-#include "scene_checker.hpp"
+#include "fluid_scene_rules.hpp"
 
-namespace hfmpm::coupling {
+namespace hfmpm::fluid {
+
+using proto::check_time_function;
+using proto::Checker;
+using proto::kInf;
+using proto::text;
+
 namespace {
 
 // What the fluid needs to know about each crack of the solid in the scene.
@@ -122,4 +128,4 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   }
 }
 
-}  // namespace hfmpm::coupling
+}  // namespace hfmpm::fluid

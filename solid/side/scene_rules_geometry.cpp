@@ -5,9 +5,13 @@
 #include <cmath>
 #include <vector>
 
-#include "scene_checker.hpp"
+#include "solid_scene_rules.hpp"
 
-namespace hfmpm::coupling {
+namespace hfmpm::solid {
+
+using proto::Checker;
+using proto::kInf;
+using proto::text;
 namespace {
 
 // ------------------------------------------------------------- geometry
@@ -271,4 +275,4 @@ void check_regions_in_grid(Checker& c, const scene::MpmSolid& m) {
   }
 }
 
-}  // namespace hfmpm::coupling
+}  // namespace hfmpm::solid

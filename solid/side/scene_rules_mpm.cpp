@@ -1,13 +1,18 @@
 // Rules for solid.mpm: grid, materials, regions, constraints, tractions
-// (geometry: scene_validate_geometry.cpp; cost: scene_size.cpp).
+// (geometry: scene_rules_geometry.cpp; cost: scene_size.cpp).
 #include <algorithm>
 #include <cmath>
 #include <set>
 #include <vector>
 
-#include "scene_checker.hpp"
+#include "solid_scene_rules.hpp"
 
-namespace hfmpm::coupling {
+namespace hfmpm::solid {
+
+using proto::check_time_function;
+using proto::Checker;
+using proto::kInf;
+using proto::text;
 namespace {
 
 // Memory check: the estimate against the machine's physical memory.
@@ -243,4 +248,4 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   check_memory(c, m);
 }
 
-}  // namespace hfmpm::coupling
+}  // namespace hfmpm::solid

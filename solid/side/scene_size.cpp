@@ -4,10 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
-#include "scene_checker.hpp"
+#include "solid_scene_rules.hpp"
 
-namespace hfmpm::coupling {
+namespace hfmpm::solid {
 
 double mpm_solid_nodes(const scene::MpmSolid& m) {
   const auto& g = m.grid();
@@ -83,4 +84,4 @@ double mpm_solid_stable_dt(const scene::MpmSolid& m) {
   return cfl * h / fastest;
 }
 
-}  // namespace hfmpm::coupling
+}  // namespace hfmpm::solid
