@@ -241,6 +241,16 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   const coupling::SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
   const scene::Scene scene =
       scene_path.empty() ? restart_point->state.scene() : coupling::load_scene(scene_path, rules, overrides);
+  if (restart_point && scene_path.empty()) {
+    // The checkpoint's own scene, checked as a scene file is: a checkpoint this
+    // program wrote holds a valid one, but a damaged or foreign one must be
+    // refused here, with its problems named, not by a side after the start.
+    std::vector<std::string> lines;
+    for (const auto& p : coupling::validate(scene, rules)) {
+      lines.push_back(restart + "/" + restart_point->directory + "/coupler.pb: " + proto::problem_text(p));
+    }
+    if (!lines.empty()) throw coupling::SceneError(lines);
+  }
   if (restart_point) {
     try {
       coupling::check_restart_scene(*restart_point, scene);

@@ -18,6 +18,7 @@
 #include "coupled_support.hpp"
 #include "h5_reader.hpp"
 #include "hfmpm/checkpoint.pb.h"
+#include "hfmpm/proto/envelope.hpp"
 
 namespace hfmpm::test {
 namespace {
@@ -306,6 +307,7 @@ TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {
     ASSERT_TRUE(state.ParseFromIstream(&in));
   }
   const std::string good = read_file(last + "/coupler.pb");
+  const std::string good_version = state.program_version();
   state.set_program_version("0.0.1");
   {
     std::ofstream out_file(last + "/coupler.pb", std::ios::binary);
@@ -314,6 +316,20 @@ TEST(Restart, RefusesAnotherSceneAnotherVersionOrNoCheckpoint) {
   const auto version = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 60);
   EXPECT_EQ(version.exit_code, 2);
   EXPECT_NE(version.err.find("was written by hfmpm 0.0.1; this is hfmpm"), std::string::npos) << version.err;
+
+  // A scene in the coupler's file that breaks a rule (its hash made to match,
+  // as a foreign or hand-made checkpoint could): refused before any process
+  // starts, with the file and the key named as for a scene file.
+  state.set_program_version(good_version);
+  state.mutable_scene()->mutable_time()->set_end_s(-1);
+  state.set_scene_hash(proto::scene_hash(state.scene()));
+  {
+    std::ofstream out_file(last + "/coupler.pb", std::ios::binary);
+    ASSERT_TRUE(state.SerializeToOstream(&out_file));
+  }
+  const auto invalid = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 60);
+  EXPECT_EQ(invalid.exit_code, 2);
+  EXPECT_NE(invalid.err.find("/coupler.pb: time.end_s"), std::string::npos) << invalid.err;
   write_file(last + "/coupler.pb", good);
 
   // After the refusals the checkpoint still continues the run (with its own scene).
