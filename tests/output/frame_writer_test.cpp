@@ -187,22 +187,9 @@ TEST(FrameWriter, CanBeMoved) {
 
 namespace {
 
-// A StateWriter / StateReader in memory (checkpoints go to HDF5 through hfmpm_output's
-// write_checkpoint; the writer's save/resume do not depend on that).
-class MemoryState final : public hfmpm::StateWriter, public hfmpm::StateReader {
- public:
-  void f64(const std::string& name, const std::vector<double>& v) override { reals_[name] = v; }
-  void u64(const std::string& name, const std::vector<std::uint64_t>& v) override { ints_[name] = v; }
-  void text(const std::string& name, const std::string& bytes) override { texts_[name] = bytes; }
-  std::vector<double> f64(const std::string& name) const override { return reals_.at(name); }
-  std::vector<std::uint64_t> u64(const std::string& name) const override { return ints_.at(name); }
-  std::string text(const std::string& name) const override { return texts_.at(name); }
-
- private:
-  std::map<std::string, std::vector<double>> reals_;
-  std::map<std::string, std::vector<std::uint64_t>> ints_;
-  std::map<std::string, std::string> texts_;
-};
+// The writer's state goes to an archive in memory (hfmpm::MemoryState; checkpoints go to
+// HDF5 through hfmpm_output's write_checkpoint; save/resume do not depend on that).
+using hfmpm::MemoryState;
 
 // A restart: the writer's state saved after frame 2, frame 3 written by a run that is then
 // killed; the resumed writer drops frame 3 and writes it again: the files hold exactly the

@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -137,21 +136,6 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
 // saved, loaded into a new solver from the same config, and both are stepped
 // 400 steps (a growth step of each tip and its settling in between); the
 // particles, the crack and J and K at the tips must agree exactly.
-class MemoryState final : public StateWriter, public StateReader {
- public:
-  void f64(const std::string& name, const std::vector<double>& v) override { reals_[name] = v; }
-  void u64(const std::string& name, const std::vector<std::uint64_t>& v) override { ints_[name] = v; }
-  void text(const std::string& name, const std::string& bytes) override { texts_[name] = bytes; }
-  std::vector<double> f64(const std::string& name) const override { return reals_.at(name); }
-  std::vector<std::uint64_t> u64(const std::string& name) const override { return ints_.at(name); }
-  std::string text(const std::string& name) const override { return texts_.at(name); }
-
- private:
-  std::map<std::string, std::vector<double>> reals_;
-  std::map<std::string, std::vector<std::uint64_t>> ints_;
-  std::map<std::string, std::string> texts_;
-};
-
 TEST(ObliqueGrowth, CheckpointOfAKinkedCrackRestartsBitForBit) {
   const double h = kA / 5, b = 5 * kA, k_ic = 1e6;
   SolidConfig c = oblique_crack(h, b, kPi / 4, Vec2(h / 2, 0), 0, 0, k_ic);

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cstdint>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -124,6 +125,29 @@ class PrefixedReader final : public StateReader {
  private:
   const StateReader& inner_;
   std::string prefix_;
+};
+
+// A state archive in memory: what is written can be read back at once (tests of
+// save and load, and in-process copies of a state, without a file).
+class MemoryState final : public StateWriter, public StateReader {
+ public:
+  void f64(const std::string& name, const std::vector<double>& v) override { reals_[name] = v; }
+  void u64(const std::string& name, const std::vector<std::uint64_t>& v) override { ints_[name] = v; }
+  void text(const std::string& name, const std::string& bytes) override { texts_[name] = bytes; }
+  std::vector<double> f64(const std::string& name) const override { return find(reals_, name); }
+  std::vector<std::uint64_t> u64(const std::string& name) const override { return find(ints_, name); }
+  std::string text(const std::string& name) const override { return find(texts_, name); }
+
+ private:
+  template <class Map>
+  static const typename Map::mapped_type& find(const Map& map, const std::string& name) {
+    const auto it = map.find(name);
+    if (it == map.end()) throw std::runtime_error("the state has no array '" + name + "' of this type");
+    return it->second;
+  }
+  std::map<std::string, std::vector<double>> reals_;
+  std::map<std::string, std::vector<std::uint64_t>> ints_;
+  std::map<std::string, std::string> texts_;
 };
 
 }  // namespace hfmpm
