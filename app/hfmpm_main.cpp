@@ -4,9 +4,11 @@
 #include <google/protobuf/util/json_util.h>
 
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <sstream>
 
 #include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/coupler.hpp"
@@ -20,6 +22,7 @@
 #include "mpm_solid_side.hpp"
 #include "prescribed_fluid_side.hpp"
 #include "prescribed_solid_side.hpp"
+#include "scene_builder.hpp"
 #include "solid_scene_rules.hpp"
 
 namespace {
@@ -52,6 +55,11 @@ constexpr const char* kUsage = R"(usage:
       finishing: a run.json left at "running" by a coupler that was killed
       (kill -9, a crash, a reboot) gets the status: stopped without finishing
       (coupler killed?). 'hfmpm run --restart DIR' does the same.
+  hfmpm scene PROBLEM [--out FILE]
+      Build a full scene from a hydraulic-fracture problem given by its physics alone
+      (rock, in-situ stress, fluid, injection, duration, notch; proto/hfmpm/problem.proto,
+      e.g. scenarios/problems/*.problem). Every numerical setting is derived from the
+      physics and commented with its reason; the scene goes to FILE or standard output.
   hfmpm validate SCENE [--set KEY=VALUE]... [--json]
       Check SCENE and print it with every default filled in (--json: as JSON, for
       scripts; every run also writes it to OUT/scene.json), after what the run will
@@ -145,6 +153,58 @@ int status(const std::vector<std::string>& args) {
                 << "\", but " << state.detail << " (" << describe(state) << "); recorded in run.json\n";
       break;
   }
+  return 0;
+}
+
+// hfmpm scene PROBLEM [--out FILE]: a scene from physics alone.
+int build_scene_command(const std::vector<std::string>& args) {
+  std::string problem_path, out;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--out") {
+      if (i + 1 >= args.size() || args[i + 1].empty()) throw UsageError("--out needs a file name");
+      out = args[++i];
+    } else if (!args[i].empty() && args[i][0] == '-') {
+      throw UsageError("unknown option '" + args[i] + "' for 'hfmpm scene'; allowed: --out FILE");
+    } else if (problem_path.empty()) {
+      problem_path = args[i];
+    } else {
+      throw UsageError("more than one problem given ('" + problem_path + "' and '" + args[i] + "')");
+    }
+  }
+  if (problem_path.empty()) throw UsageError("'hfmpm scene' needs a problem file");
+  std::ifstream in(problem_path);
+  if (!in) {
+    std::cerr << "hfmpm: cannot read the problem file " << problem_path << "\n";
+    return 2;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  app::BuiltScene built;
+  try {
+    built = app::build_scene(app::parse_problem(text.str(), problem_path));
+  } catch (const app::ProblemError& e) {
+    std::cerr << "hfmpm: invalid problem:\n";
+    for (const auto& line : e.problems) std::cerr << "  " << problem_path << ": " << line << "\n";
+    return 2;
+  }
+  // The scene built must be one the coupler and both sides accept: checked
+  // here with their rules, so that a builder bug cannot reach a run.
+  const coupling::SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
+  const scene::Scene checked = coupling::parse_scene(built.text, problem_path + " (built scene)", rules);
+  if (out.empty()) {
+    std::cout << built.text;
+    return 0;
+  }
+  std::ofstream file(out);
+  file << built.text;
+  file.close();
+  if (!file) {
+    std::cerr << "hfmpm: cannot write " << out << "\n";
+    return 1;
+  }
+  std::cout << "hfmpm: wrote " << out << " (" << checked.name() << "): Km = " << built.derived.km << ", "
+            << (built.derived.viscosity_dominated ? "viscosity" : "toughness") << "-dominated, cell "
+            << built.derived.cell << " m; 'hfmpm validate " << out << "' gives the cost\n";
   return 0;
 }
 
@@ -352,8 +412,9 @@ int main(int argc, char** argv) {
   try {
     if (command == "keygen") return keygen(args);
     if (command == "status") return status(args);
+    if (command == "scene") return build_scene_command(args);
     if (command != "run" && command != "coupler" && command != "validate") {
-      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, status, validate, keygen");
+      throw UsageError("unknown command '" + command + "'; allowed: run, coupler, scene, status, validate, keygen");
     }
     return run(command, args);
   } catch (const UsageError& e) {

@@ -1,0 +1,313 @@
+#include "scene_builder.hpp"
+
+#include <google/protobuf/io/tokenizer.h>
+#include <google/protobuf/text_format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <regex>
+#include <sstream>
+
+namespace hfmpm::app {
+namespace {
+
+std::string join(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) out += (out.empty() ? "" : "\n") + l;
+  return out;
+}
+
+std::string num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", v);
+  return buffer;
+}
+
+// For the comments: three significant digits.
+std::string approx(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  return buffer;
+}
+
+// x rounded to `digits` significant digits, down (floor) or to nearest.
+double significant(double x, int digits, bool down) {
+  if (!(x > 0)) return x;
+  const double scale = std::pow(10.0, digits - 1 - static_cast<int>(std::floor(std::log10(x))));
+  return (down ? std::floor(x * scale) : std::round(x * scale)) / scale;
+}
+
+struct ErrorCollector : google::protobuf::io::ErrorCollector {
+  std::vector<std::string> errors;
+  std::string name;
+  void AddError(int line, int column, const std::string& message) override {
+    errors.push_back(name + ":" + std::to_string(line + 1) + ":" + std::to_string(column + 1) + ": " + message);
+  }
+};
+
+// The checks of a problem: each failing one adds "key = value is not allowed; allowed: range".
+class Checks {
+ public:
+  void require(bool present, const std::string& key) {
+    if (!present) problems_.push_back(key + " is required");
+  }
+  void range(const std::string& key, double v, bool ok, const std::string& allowed) {
+    if (!ok || !std::isfinite(v)) problems_.push_back(key + " = " + num(v) + " is not allowed; allowed: " + allowed);
+  }
+  void fail(const std::string& line) { problems_.push_back(line); }
+  const std::vector<std::string>& problems() const { return problems_; }
+
+ private:
+  std::vector<std::string> problems_;
+};
+
+void check(const problem::Problem& p, Checks& c) {
+  c.require(p.has_name(), "name");
+  if (p.has_name() && !std::regex_match(p.name(), std::regex("[A-Za-z0-9_.-]{1,64}"))) {
+    c.fail("name = '" + p.name() + "' is not allowed; allowed: 1 to 64 of [A-Za-z0-9_.-]");
+  }
+  c.require(p.has_rock(), "rock");
+  c.require(p.has_in_situ(), "in_situ");
+  c.require(p.has_fluid(), "fluid");
+  c.require(p.has_injection(), "injection");
+  c.require(p.has_duration_s(), "duration_s");
+  c.require(p.has_notch_m(), "notch_m");
+  if (p.has_duration_s()) c.range("duration_s", p.duration_s(), p.duration_s() > 0, "> 0 s");
+  if (p.has_notch_m()) c.range("notch_m", p.notch_m(), p.notch_m() > 0, "> 0 m");
+  if (p.has_rock()) {
+    const auto& r = p.rock();
+    c.require(r.has_youngs_modulus_pa(), "rock.youngs_modulus_pa");
+    c.require(r.has_poisson_ratio(), "rock.poisson_ratio");
+    c.require(r.has_toughness_pa_sqrt_m(), "rock.toughness_pa_sqrt_m");
+    c.range("rock.youngs_modulus_pa", r.youngs_modulus_pa(), !r.has_youngs_modulus_pa() || r.youngs_modulus_pa() > 0,
+            "> 0 Pa");
+    c.range("rock.poisson_ratio", r.poisson_ratio(), r.poisson_ratio() >= 0 && r.poisson_ratio() < 0.5, "[0, 0.5)");
+    c.range("rock.density_kg_m3", r.density_kg_m3(), r.density_kg_m3() > 0, "> 0 kg/m^3");
+    c.range("rock.toughness_pa_sqrt_m", r.toughness_pa_sqrt_m(), r.toughness_pa_sqrt_m() >= 0, ">= 0 Pa m^0.5");
+  }
+  if (p.has_in_situ()) {
+    const auto& s = p.in_situ();
+    c.require(s.has_normal_to_crack_pa(), "in_situ.normal_to_crack_pa");
+    c.range("in_situ.normal_to_crack_pa", s.normal_to_crack_pa(), s.normal_to_crack_pa() >= 0,
+            ">= 0 Pa (a compressive magnitude)");
+    if (s.has_along_crack_pa()) {
+      c.range("in_situ.along_crack_pa", s.along_crack_pa(), s.along_crack_pa() >= 0,
+              ">= 0 Pa (a compressive magnitude)");
+    }
+  }
+  if (p.has_fluid()) {
+    const auto& f = p.fluid();
+    c.require(f.has_viscosity_pa_s(), "fluid.viscosity_pa_s");
+    c.range("fluid.density_kg_m3", f.density_kg_m3(), f.density_kg_m3() > 0, "> 0 kg/m^3");
+    c.range("fluid.bulk_modulus_pa", f.bulk_modulus_pa(), f.bulk_modulus_pa() > 0, "> 0 Pa");
+    c.range("fluid.viscosity_pa_s", f.viscosity_pa_s(), !f.has_viscosity_pa_s() || f.viscosity_pa_s() > 0,
+            "> 0 Pa s (the builder sizes the run by the viscous and toughness vertices)");
+  }
+  if (p.has_injection()) {
+    const auto& i = p.injection();
+    c.require(i.has_total_rate_m2_s(), "injection.total_rate_m2_s");
+    c.range("injection.total_rate_m2_s", i.total_rate_m2_s(), !i.has_total_rate_m2_s() || i.total_rate_m2_s() > 0,
+            "> 0 m^2/s");
+    if (i.has_ramp_s()) {
+      const bool ok = i.ramp_s() >= 0 && (!p.has_duration_s() || i.ramp_s() <= 0.5 * p.duration_s());
+      c.range("injection.ramp_s", i.ramp_s(), ok, "[0, duration_s / 2] s");
+    }
+  }
+  const auto& a = p.accuracy();
+  c.range("accuracy.cells_per_half_length", a.cells_per_half_length(),
+          a.cells_per_half_length() >= 8 && a.cells_per_half_length() <= 200, "[8, 200]");
+  c.range("accuracy.box_half_lengths", a.box_half_lengths(), a.box_half_lengths() >= 2 && a.box_half_lengths() <= 20,
+          "[2, 20]");
+}
+
+}  // namespace
+
+ProblemError::ProblemError(const std::vector<std::string>& lines) : std::runtime_error(join(lines)), problems(lines) {}
+
+Vertex m_vertex(double e_prime, double viscosity, double total_rate, double t) {
+  const double mu = 12 * viscosity, q = total_rate;
+  Vertex v;
+  v.half_length = 0.6152 * std::pow(e_prime * q * q * q * t * t * t * t / mu, 1.0 / 6);
+  v.opening = 1.126 * std::pow(mu * q * q * q * t * t / e_prime, 1.0 / 6);
+  v.net_pressure = 0.545 * std::cbrt(mu * e_prime * e_prime / t);
+  return v;
+}
+
+Vertex k_vertex(double e_prime, double toughness, double total_rate, double t) {
+  const double k = std::sqrt(32 / std::numbers::pi) * toughness, q = total_rate;
+  Vertex v;
+  v.half_length = 2 / std::cbrt(std::numbers::pi * std::numbers::pi) * std::pow(e_prime * q * t / k, 2.0 / 3);
+  v.opening = std::cbrt(k * k * q * t / (std::numbers::pi * e_prime * e_prime));
+  v.net_pressure = std::cbrt(std::numbers::pi) / 8 * std::cbrt(k * k * k * k / (e_prime * q * t));
+  return v;
+}
+
+double toughness_number(double e_prime, double viscosity, double total_rate, double toughness) {
+  const double k = std::sqrt(32 / std::numbers::pi) * toughness;
+  return k / std::pow(e_prime * e_prime * e_prime * 12 * viscosity * total_rate, 0.25);
+}
+
+problem::Problem parse_problem(const std::string& text, const std::string& name) {
+  problem::Problem p;
+  google::protobuf::TextFormat::Parser parser;
+  ErrorCollector errors;
+  errors.name = name;
+  parser.RecordErrorsTo(&errors);
+  if (!parser.ParseFromString(text, &p)) {
+    if (errors.errors.empty()) errors.errors.push_back(name + ": not a problem file (problem.proto text format)");
+    throw ProblemError(errors.errors);
+  }
+  return p;
+}
+
+BuiltScene build_scene(const problem::Problem& p) {
+  Checks checks;
+  check(p, checks);
+  if (!checks.problems().empty()) throw ProblemError(checks.problems());
+
+  const auto& rock = p.rock();
+  const auto& fluid = p.fluid();
+  const double nu = rock.poisson_ratio(), e = rock.youngs_modulus_pa();
+  const double q = p.injection().total_rate_m2_s(), t_end = p.duration_s();
+  const double ramp = p.injection().has_ramp_s() ? p.injection().ramp_s() : 0.01 * t_end;
+  const double sigma_n = p.in_situ().normal_to_crack_pa();
+  const double sigma_a = p.in_situ().has_along_crack_pa() ? p.in_situ().along_crack_pa() : sigma_n;
+  const double cells_per_l = p.accuracy().cells_per_half_length(), box = p.accuracy().box_half_lengths();
+
+  Derived d;
+  d.e_prime = e / (1 - nu * nu);
+  d.km = toughness_number(d.e_prime, fluid.viscosity_pa_s(), q, rock.toughness_pa_sqrt_m());
+  d.viscosity_dominated = d.km < 1;
+  // A ramp over t_r injects the volume of a constant rate started t_r / 2 later.
+  const double t_eff = t_end - 0.5 * ramp;
+  const Vertex m = m_vertex(d.e_prime, fluid.viscosity_pa_s(), q, t_eff);
+  const Vertex k = k_vertex(d.e_prime, rock.toughness_pa_sqrt_m(), q, t_eff);
+  d.end = d.viscosity_dominated ? m : k;
+  // Viscosity and toughness both shorten the crack: it is no longer than either vertex.
+  const double l_end = std::min(m.half_length, rock.toughness_pa_sqrt_m() > 0 ? k.half_length : m.half_length);
+  d.end.half_length = l_end;
+  if (!(l_end >= 1.5 * p.notch_m())) {
+    throw ProblemError({"the fracture would hardly grow beyond its notch: expected half-length " + num(l_end) +
+                        " m at duration_s = " + num(t_end) + " s against notch_m = " + num(p.notch_m()) +
+                        " m; allowed: an expected half-length of at least 1.5 notch lengths (inject longer or start "
+                        "from a shorter notch)"});
+  }
+  // The cell: cells_per_half_length along the expected final half-length, and
+  // at least two cells along the notch (the fluid's first grid).
+  d.cell = significant(std::min(l_end / cells_per_l, 0.5 * p.notch_m()), 3, true);
+  const double h = d.cell;
+  const double reach = box * l_end;
+  d.cells_x = static_cast<int>(std::ceil(reach / h));
+  d.cells_y_half = d.cells_x;
+  const double density = rock.density_kg_m3();
+  const double p_modulus = e * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
+  const double c_p = std::sqrt(p_modulus / density), c_s = std::sqrt(e / (2 * (1 + nu)) / density);
+  // Quasi-static density scaling: the scaled P-wave crosses the final
+  // half-length in 0.5% of the injection time. With toughness, the settling
+  // wait after each growth step (2 shear transits of the crack per quarter
+  // cell) must not cap the tip below twice the vertex's final speed.
+  const double v_tip = 2.0 / 3.0 * l_end / t_end;
+  double scaling = std::pow(c_p * 0.005 * t_end / l_end, 2);
+  const double growth = d.viscosity_dominated ? 0.5 : 0.25, settle = d.viscosity_dominated ? 0.0 : 2.0;
+  if (settle > 0) {
+    const double c_s_needed = 2 * settle * l_end * v_tip / (growth * h);
+    scaling = std::min(scaling, std::pow(c_s / c_s_needed, 2));
+  }
+  d.density_scaling = significant(std::max(1.0, scaling), 2, true);
+  d.virtual_opening = significant(0.01 * d.end.opening, 2, false);
+
+  // Grid: the crack on y = 0 between node rows; two empty cells beyond the body.
+  const int nx = d.cells_x, ny = d.cells_y_half;
+  const double body_x = nx * h, body_y = (ny + 0.5) * h;
+  const double grid_x = (nx + 2) * h, grid_y = (ny + 2.5) * h;
+  const int near_x = std::min(nx, static_cast<int>(std::ceil(1.5 * l_end / h)));
+  const int near_y = std::min(ny, static_cast<int>(std::ceil(0.5 * l_end / h)));
+  const double near_body_x = near_x * h, near_body_y = (near_y + 0.5) * h;
+  const double scaled_cp = c_p / std::sqrt(d.density_scaling);
+
+  std::ostringstream s;
+  const std::string regime =
+      d.viscosity_dominated ? "viscosity-dominated (M-vertex)" : "toughness-dominated (K-vertex)";
+  s << "# Built by `hfmpm scene` from the problem '" << p.name() << "' (physics only; docs/scenes.md,\n"
+    << "# \"A scene from physics alone\"). Every numerical setting below is derived from the\n"
+    << "# physics, with its reason; any of them can still be overridden with --set.\n"
+    << "#   E' = " << approx(d.e_prime) << " Pa, Km = " << approx(d.km) << ": " << regime << ".\n"
+    << "#   Expected at the end (the " << (d.viscosity_dominated ? "M" : "K")
+    << "-vertex, time less half the ramp): half-length " << approx(l_end) << " m,\n"
+    << "#   mouth opening " << approx(d.end.opening) << " m, net inlet pressure " << approx(d.end.net_pressure)
+    << " Pa.\n"
+    << "#   cell " << approx(h) << " m: " << approx(l_end / h) << " cells along that half-length (accuracy "
+    << approx(cells_per_l) << "), " << approx(p.notch_m() / h) << " along the notch (at least 2).\n"
+    << "#   body " << approx(body_x) << " m x +-" << approx(body_y) << " m: " << approx(box)
+    << " final half-lengths beyond the crack; 2 x 2 particles per cell within 1.5 x +-0.5 of\n"
+    << "#   them around the crack, one beyond.\n"
+    << "#   density_scaling " << approx(d.density_scaling) << ": the scaled P-wave (" << approx(scaled_cp)
+    << " m/s) crosses the final half-length in " << approx(100 * l_end / scaled_cp / t_end)
+    << "% of the injection time\n"
+    << "#   (target 0.5%"
+    << (settle > 0 ? "; with toughness, the settling wait may not cap the tip below 2x its speed" : "")
+    << "), and outruns the tip's final speed " << approx(scaled_cp / v_tip) << "-fold.\n"
+    << "#   coupling IMPLICIT: the fluid's pressure is solved with the crack's opening, so any fluid\n"
+    << "#   (water too) runs at the solid's step, which the program chooses (safety 0.9).\n"
+    << "#   closure: "
+    << (d.viscosity_dominated ? "the dry tip zone carries the confining stress normal to the crack (zero-lag),\n"
+                                "#   the tip waits for the fluid within 0.5 cell and grows by 0.5 cell.\n"
+                              : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
+                                "#   the tip waits for the fluid within 0.25 cell, grows by 0.25 cell and lets the "
+                                "opening follow (2 transits).\n")
+    << "#   virtual opening " << approx(d.virtual_opening) << " m: 1% of the expected final mouth opening.\n"
+    << "#   ramp " << approx(ramp) << " s" << (p.injection().has_ramp_s() ? "" : " (1% of the duration)")
+    << ": no water hammer at the start.\n";
+  if (p.has_description()) s << "# " << p.description() << "\n";
+  s << "name: \"" << p.name() << "\"\n"
+    << "description: \"KGD from physics: " << regime << ", Km = " << num(d.km) << "\"\n"
+    << "time { end_s: " << num(t_end) << " safety_factor: 0.9 }\n"
+    << "output { interval_s: " << num(t_end / 20) << " }\n"
+    << "coupling { transport: IPC scheme: IMPLICIT exchange_interval: 1 control_interval: 20 }\n"
+    << "solid {\n  mpm {\n"
+    << "    grid { x_min_m: 0 y_min_m: " << num(-grid_y) << " x_max_m: " << num(grid_x) << " y_max_m: " << num(grid_y)
+    << " }\n"
+    << "    cell_size_m: " << num(h) << "\n"
+    << "    materials { name: \"rock\" youngs_modulus_pa: " << num(e) << " poisson_ratio: " << num(nu)
+    << " density_kg_m3: " << num(density) << " toughness_pa_sqrt_m: " << num(rock.toughness_pa_sqrt_m()) << " }\n";
+  const std::string stress = "initial_stress { xx_pa: " + num(-sigma_a) + " yy_pa: " + num(-sigma_n) + " }";
+  s << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << num(-body_y)
+    << " x_max_m: " << num(body_x) << " y_max_m: " << num(body_y) << " }\n              " << stress
+    << " particles_per_cell: 1 }\n"
+    << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << num(-near_body_y)
+    << " x_max_m: " << num(near_body_x) << " y_max_m: " << num(near_body_y) << " }\n              " << stress
+    << " particles_per_cell: 2 }\n"
+    << "    constraints { symmetry_x_m: 0 }\n"
+    << "    tractions { edge: RIGHT normal_pa { constant: " << num(-sigma_a) << " } }\n"
+    << "    tractions { edge: TOP normal_pa { constant: " << num(-sigma_n) << " } }\n"
+    << "    tractions { edge: BOTTOM normal_pa { constant: " << num(-sigma_n) << " } }\n"
+    << "    silent_edges: [RIGHT, TOP, BOTTOM]\n"
+    << "    density_scaling: " << num(d.density_scaling) << "\n"
+    << "    in_situ_reference: true\n"
+    << "    damping { grid_alpha_per_s: 5 pic_fraction: 0.5 }\n"
+    << "    fracture { j_inner_cells: 1 j_outer_cells: 3 propagate: true growth_cells: " << num(growth)
+    << " check_interval: 2 direction: STRAIGHT\n               max_lag_cells: " << num(growth)
+    << (settle > 0 ? " settle_transits: 2" : "") << " }\n"
+    << "    cracks { x_m: [0, " << num(p.notch_m()) << "] y_m: [0, 0] start_is_tip: false end_is_tip: true }\n"
+    << "  }\n}\n"
+    << "fluid {\n  mpm {\n"
+    << "    density_kg_m3: " << num(fluid.density_kg_m3()) << "\n"
+    << "    bulk_modulus_pa: " << num(fluid.bulk_modulus_pa()) << "\n"
+    << "    viscosity_pa_s: " << num(fluid.viscosity_pa_s()) << "\n"
+    << "    inlet { flow_rate_m2_s { "
+    << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(0.5 * q) + " }" : "constant: " + num(0.5 * q))
+    << " } }   # one wing: half the total rate\n"
+    << "    initial_fill { front_m: " << num(p.notch_m()) << " pressure_pa: " << num(sigma_n) << " }\n"
+    << "    virtual_opening_m: " << num(d.virtual_opening) << "\n";
+  if (d.viscosity_dominated) {
+    s << "    lag: FIXED_PRESSURE lag_pressure_pa: " << num(sigma_n) << "\n";
+  } else {
+    s << "    lag: FRONT_PRESSURE\n";
+  }
+  s << "    merge_fraction: 0.5\n    max_substeps: 1000\n  }\n}\n";
+  return {s.str(), d};
+}
+
+}  // namespace hfmpm::app

@@ -1,0 +1,57 @@
+// A scene from physics alone (`hfmpm scene PROBLEM`): a plane-strain (KGD)
+// hydraulic fracture given as rock, in-situ stress, fluid, injection,
+// duration and notch (proto/hfmpm/problem.proto) becomes a full scene whose
+// every numerical setting is derived from that physics, each with its reason
+// as a comment (docs/scenes.md, "A scene from physics alone").
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "hfmpm/problem.pb.h"
+
+namespace hfmpm::app {
+
+// A problem the builder cannot make a scene for: one line per problem, each
+// naming the key, its value and what is allowed.
+struct ProblemError : std::runtime_error {
+  explicit ProblemError(const std::vector<std::string>& problems);
+  std::vector<std::string> problems;
+};
+
+// The plane-strain vertex solutions the builder sizes the run with
+// (zero lag, impermeable rock, Newtonian fluid; Q the total rate of both
+// wings; half-length l, mouth opening w0, net inlet pressure p0 at time t).
+struct Vertex {
+  double half_length = 0, opening = 0, net_pressure = 0;
+};
+// Viscosity-dominated (M): Spence and Sharp 1985, Adachi and Detournay 2002.
+Vertex m_vertex(double e_prime, double viscosity, double total_rate, double t);
+// Toughness-dominated (K): a uniformly loaded crack with K_I = K_Ic and the injected volume.
+Vertex k_vertex(double e_prime, double toughness, double total_rate, double t);
+// Km = K' / (E'^3 mu' Q)^(1/4), K' = sqrt(32/pi) K_Ic, mu' = 12 mu.
+double toughness_number(double e_prime, double viscosity, double total_rate, double toughness);
+
+// What the builder derived (also written into the scene's comments).
+struct Derived {
+  double e_prime = 0, km = 0;
+  bool viscosity_dominated = true;  // Km < 1: the M-vertex's closure and checks
+  Vertex end;                       // the regime's vertex at the end (time shifted by half the ramp)
+  double cell = 0;                  // m
+  double density_scaling = 1;
+  double virtual_opening = 0;  // m
+  int cells_x = 0, cells_y_half = 0;
+};
+
+struct BuiltScene {
+  std::string text;  // the scene, Protobuf text format with comments
+  Derived derived;
+};
+
+// Parses a problem file's text; a syntax error names the line and column.
+problem::Problem parse_problem(const std::string& text, const std::string& name);
+// Throws ProblemError for a problem outside what the builder supports.
+BuiltScene build_scene(const problem::Problem& problem);
+
+}  // namespace hfmpm::app

@@ -1,0 +1,183 @@
+// hfmpm scene: a scene from physics alone (app/scene_builder.hpp).
+// The vertex formulas are checked against values computed independently
+// from the published solutions; the built scenes against the coupler's and
+// both sides' rules and against the derivation rules they state; bad
+// problems against the messages a user gets.
+#include "scene_builder.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "fluid_scene_rules.hpp"
+#include "hfmpm/coupling/scene_loader.hpp"
+#include "solid_scene_rules.hpp"
+
+namespace hfmpm::app {
+namespace {
+
+using ::testing::HasSubstr;
+
+// The method paper's field set-up (scenarios/problems/kgd-paper-field.problem).
+problem::Problem field_problem() {
+  return parse_problem(R"(
+    name: "field"
+    rock { youngs_modulus_pa: 2e10 poisson_ratio: 0.25 density_kg_m3: 2600 toughness_pa_sqrt_m: 5e3 }
+    in_situ { normal_to_crack_pa: 1e6 }
+    fluid { viscosity_pa_s: 1e-4 }
+    injection { total_rate_m2_s: 2e-5 ramp_s: 5 }
+    duration_s: 300
+    notch_m: 2)",
+                       "field");
+}
+
+// scenarios/problems/lab-toughness.problem: Km = 7.6.
+problem::Problem toughness_problem() {
+  return parse_problem(R"(
+    name: "tough"
+    rock { youngs_modulus_pa: 1e7 poisson_ratio: 0.25 density_kg_m3: 2500 toughness_pa_sqrt_m: 25e3 }
+    in_situ { normal_to_crack_pa: 1e5 along_crack_pa: 2e5 }
+    fluid { viscosity_pa_s: 0.001 }
+    injection { total_rate_m2_s: 8.3e-4 ramp_s: 0.05 }
+    duration_s: 5
+    notch_m: 0.15)",
+                       "tough");
+}
+
+scene::Scene checked(const BuiltScene& built) {
+  const coupling::SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
+  return coupling::parse_scene(built.text, "built", rules);  // throws SceneError if any side refuses it
+}
+
+// M-vertex: l = 0.6152 (E' Q^3 t^4 / mu')^(1/6), w0 = 1.126 (mu' Q^3 t^2 / E')^(1/6),
+// p0 = 0.545 (mu' E'^2 / t)^(1/3); K-vertex: l = 0.93239 (E' Q t / K')^(2/3),
+// w0 = 0.68278 (K'^2 Q t / E'^2)^(1/3), p0 = 0.18308 (K'^4 / (E' Q t))^(1/3).
+// Expected values: these formulas evaluated separately (Python, double
+// precision); the tolerance 1e-5 is their printed precision.
+TEST(SceneBuilder, VertexFormulasGiveThePublishedSolutions) {
+  const double e_prime = 2e10 / (1 - 0.0625);
+  const Vertex m = m_vertex(e_prime, 1e-4, 2e-5, 297.5);
+  EXPECT_NEAR(m.half_length / 19.80777, 1, 1e-5);
+  EXPECT_NEAR(m.opening / 2.080828e-4, 1, 1e-5);
+  EXPECT_NEAR(m.net_pressure / 6.673194e4, 1, 1e-5);
+  const double lab = 1e7 / (1 - 0.0625);
+  const Vertex k = k_vertex(lab, 25e3, 8.3e-4, 4.975);
+  EXPECT_NEAR(k.half_length / 0.6274368, 1, 1e-5);
+  EXPECT_NEAR(k.opening / 4.189685e-3, 1, 1e-5);
+  EXPECT_NEAR(k.net_pressure / 1.780656e4, 1, 1e-5);
+  EXPECT_NEAR(toughness_number(e_prime, 1e-4, 2e-5, 5e3), 0.022968, 1e-6);
+  EXPECT_NEAR(toughness_number(lab, 1e-3, 8.3e-4, 25e3), 7.609457, 1e-5);
+}
+
+TEST(SceneBuilder, ViscosityDominatedSceneFollowsItsDerivation) {
+  const BuiltScene built = build_scene(field_problem());
+  const scene::Scene s = checked(built);
+  const Derived& d = built.derived;
+  EXPECT_TRUE(d.viscosity_dominated);
+  const double l = 19.80777;  // the M-vertex's half-length at 300 s less half the 5 s ramp
+  EXPECT_NEAR(d.end.half_length / l, 1, 1e-5);
+  const auto& mpm = s.solid().mpm();
+  const double h = mpm.cell_size_m();
+  // At least 20 cells along the final half-length, and no more than the rounding of h to 3 digits adds.
+  EXPECT_GE(l / h, 20.0);
+  EXPECT_LE(l / h, 20.0 * 1.01);
+  EXPECT_GE(2.0 / h, 2.0);  // the notch: at least two cells
+  // The body reaches 5 final half-lengths; the crack lies between node rows.
+  EXPECT_GE(mpm.regions(0).rectangle().x_max_m(), 5 * l);
+  const double rows = (0 - mpm.grid().y_min_m()) / h;
+  EXPECT_NEAR(rows - std::floor(rows), 0.5, 1e-9);
+  // Quasi-static scaling: the scaled P-wave crosses l in 0.5% of the injection time (within the 2-digit rounding).
+  const double c_p = std::sqrt(2e10 * 0.75 / (1.25 * 0.5) / (2600 * mpm.density_scaling()));
+  EXPECT_GE(l / c_p / 300, 0.0045);
+  EXPECT_LE(l / c_p / 300, 0.0050);
+  // The viscous closure: the dry zone at the confining stress, the tip waiting for the fluid.
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FIXED_PRESSURE);
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e6);
+  EXPECT_DOUBLE_EQ(mpm.fracture().max_lag_cells(), 0.5);
+  EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().bulk_modulus_pa(), 2e9);  // water by default
+  // One wing: half the total rate, ramped.
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().inlet().flow_rate_m2_s().ramp().v1(), 1e-5);
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().inlet().flow_rate_m2_s().ramp().t1(), 5);
+  // The virtual film: 1% of the vertex's final mouth opening (2.08e-4 m).
+  EXPECT_NEAR(s.fluid().mpm().virtual_opening_m(), 2.1e-6, 1e-12);
+  EXPECT_THAT(built.text, HasSubstr("Km = 0.023: viscosity-dominated"));
+}
+
+TEST(SceneBuilder, ToughnessDominatedSceneTakesTheToughnessClosure) {
+  const BuiltScene built = build_scene(toughness_problem());
+  const scene::Scene s = checked(built);
+  EXPECT_FALSE(built.derived.viscosity_dominated);
+  const auto& mpm = s.solid().mpm();
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);
+  EXPECT_DOUBLE_EQ(mpm.fracture().growth_cells(), 0.25);
+  EXPECT_DOUBLE_EQ(mpm.fracture().settle_transits(), 2);
+  // The settling wait (2 shear transits of the crack per quarter-cell step) lets the tip
+  // run at least twice the K-vertex's final speed (2/3) l / t.
+  const double l = 0.6274368, h = mpm.cell_size_m();
+  const double c_s = std::sqrt(1e7 / 2.5 / (2500 * mpm.density_scaling()));
+  const double cap = 0.25 * h / (2 * l / c_s), v_tip = 2.0 / 3.0 * l / 5;
+  EXPECT_GE(cap, 2 * v_tip * 0.999);
+  // The in-situ stress: yy normal to the crack, xx along it.
+  EXPECT_DOUBLE_EQ(mpm.regions(0).initial_stress().yy_pa(), -1e5);
+  EXPECT_DOUBLE_EQ(mpm.regions(0).initial_stress().xx_pa(), -2e5);
+}
+
+// The same physics asked for finer resolution gets a finer cell in proportion.
+TEST(SceneBuilder, AccuracySetsTheCell) {
+  problem::Problem p = field_problem();
+  p.mutable_accuracy()->set_cells_per_half_length(40);
+  const double fine = build_scene(p).derived.cell, coarse = build_scene(field_problem()).derived.cell;
+  EXPECT_NEAR(coarse / fine, 2, 0.02);
+}
+
+TEST(SceneBuilder, BadProblemsAreRefusedWithTheKeyAndWhatIsAllowed) {
+  auto problems_of = [](const problem::Problem& p) {
+    try {
+      build_scene(p);
+    } catch (const ProblemError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  problem::Problem p = field_problem();
+  p.mutable_rock()->set_poisson_ratio(0.5);
+  p.mutable_fluid()->set_viscosity_pa_s(0);
+  p.clear_duration_s();
+  p.mutable_accuracy()->set_cells_per_half_length(3);
+  const std::string text = problems_of(p);
+  EXPECT_THAT(text, HasSubstr("rock.poisson_ratio = 0.5 is not allowed; allowed: [0, 0.5)"));
+  EXPECT_THAT(text, HasSubstr("fluid.viscosity_pa_s = 0 is not allowed; allowed: > 0 Pa s"));
+  EXPECT_THAT(text, HasSubstr("duration_s is required"));
+  EXPECT_THAT(text, HasSubstr("accuracy.cells_per_half_length = 3 is not allowed; allowed: [8, 200]"));
+
+  problem::Problem nan = field_problem();
+  nan.mutable_rock()->set_youngs_modulus_pa(std::nan(""));
+  EXPECT_THAT(problems_of(nan), HasSubstr("rock.youngs_modulus_pa = nan is not allowed; allowed: > 0 Pa"));
+
+  problem::Problem bad_name = field_problem();
+  bad_name.set_name("../x");
+  EXPECT_THAT(problems_of(bad_name), HasSubstr("name = '../x' is not allowed"));
+
+  // A notch longer than the crack will grow: no scene to make.
+  problem::Problem long_notch = field_problem();
+  long_notch.set_notch_m(15);
+  EXPECT_THAT(problems_of(long_notch), HasSubstr("the fracture would hardly grow beyond its notch"));
+
+  try {
+    parse_problem("rock { youngs_modulus_pa: }\n", "p.problem");
+    FAIL() << "a syntax error was accepted";
+  } catch (const ProblemError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("p.problem:1:"));
+  }
+  try {
+    parse_problem("cell_size_m: 1\n", "p.problem");
+    FAIL() << "a scene key in a problem was accepted";
+  } catch (const ProblemError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("cell_size_m"));
+  }
+}
+
+}  // namespace
+}  // namespace hfmpm::app
