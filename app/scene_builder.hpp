@@ -41,6 +41,7 @@ struct Derived {
   double cell = 0;                  // m
   double density_scaling = 1;
   double virtual_opening = 0;  // m
+  double damping = 0;          // 1/s, the grid's mass-proportional damping
   int cells_x = 0, cells_y_half = 0;
 };
 

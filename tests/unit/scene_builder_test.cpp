@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 #include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
@@ -91,6 +92,15 @@ TEST(SceneBuilder, ViscosityDominatedSceneFollowsItsDerivation) {
   const double c_p = std::sqrt(2e10 * 0.75 / (1.25 * 0.5) / (2600 * mpm.density_scaling()));
   EXPECT_GE(l / c_p / 300, 0.0045);
   EXPECT_LE(l / c_p / 300, 0.0050);
+  // Damping: at most critical for the body's lowest mode (a quarter wave across the box), and the
+  // body's delay behind a rising load, alpha / omega_1^2, at most 2% of the time at which the
+  // M-vertex reaches three notch lengths (t ~ l^(3/2)).
+  const double omega = std::numbers::pi * c_p / (2 * mpm.regions(0).rectangle().x_max_m());
+  const double alpha = mpm.damping().grid_alpha_per_s(), t_3 = 297.5 * std::pow(6 / l, 1.5);
+  EXPECT_GT(alpha, 0);
+  EXPECT_LE(alpha, 2 * omega);
+  EXPECT_LE(alpha / (omega * omega), 0.02 * t_3);
+  EXPECT_GE(alpha / (omega * omega), 0.018 * t_3);  // the lag bound is the one that acts here
   // The viscous closure: the dry zone at the confining stress, the tip waiting for the fluid.
   EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FIXED_PRESSURE);
   EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e6);
