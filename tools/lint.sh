@@ -8,6 +8,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# A missing tool must fail the check, not pass it: clang-tidy's output is
+# filtered below, so a missing one would look like a clean run.
+for tool in clang-format clang-tidy; do
+  command -v "$tool" >/dev/null || { echo "lint: $tool not found (bash tools/bootstrap.sh test installs it)" >&2; exit 2; }
+done
+
 mapfile -t sources < <(git ls-files '*.cpp' '*.hpp' '*.h' | grep -v '^build/')
 if [ "${1:-}" = "--fix" ]; then
   clang-format -i "${sources[@]}"

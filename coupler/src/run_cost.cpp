@@ -1,7 +1,8 @@
-// Run cost before a run: sizes and the step from the scene alone (each
-// side's SceneSize and SceneStep, e.g. solid/side/scene_size.cpp), wall time from throughputs measured on this
-// project's reference machine (docs/performance.md, "Water: the implicit interface scheme's cost" and the quiet-machine
-// table): kgd-viscosity, 10 s, 12,172 steps, quiet 2-core machine, 3 December.
+// Run cost before a run: sizes, the step and the wall time per coupled step
+// from the scene alone, each side's from its own rules (SideSceneRules'
+// stable_step and size, e.g. solid/side/scene_size.cpp and scene_rules.cpp,
+// with the throughputs measured on this project's reference machine:
+// docs/performance.md). The coupler adds them up; it knows no side's kind.
 #include "hfmpm/coupling/run_cost.hpp"
 
 #include <cmath>
@@ -9,18 +10,6 @@
 
 namespace hfmpm::coupling {
 namespace {
-
-// The MPM solid inside a coupled run, 2 threads: kgd-viscosity's 55.6 s of
-// solid compute for its 39,275 particles over 12,172 steps (a crack, J every
-// check, 2 x 2 particles per cell near it).
-constexpr double kSolidParticleStepsPerS = 39275.0 * 12172 / 55.6;
-// The MPM fluid and the exchange per coupled step, same runs: explicit
-// (Gauss-Seidel, 2 MPa) 3.2 s + 1.7 s, implicit interface (water) 17.4 s +
-// 2.1 s, over 12,172 steps.
-constexpr double kExplicitFluidStepS = (3.2 + 1.7) / 12172;
-constexpr double kImplicitFluidStepS = (17.4 + 2.1) / 12172;
-// A stand-in side's step and the exchange (protocol cost only).
-constexpr double kStandInStepS = 150e-6;
 
 std::string number(double v, int digits = 3) {
   char b[64];
@@ -51,17 +40,20 @@ std::string duration(double s) {
 RunCost estimate_run_cost(const scene::Scene& s, const proto::SceneRules& rules, double particles) {
   RunCost cost;
   double stable = 0;
+  proto::SceneSize solid_size, fluid_size;
+  const bool fluid = s.has_fluid() && s.fluid().model_case() != scene::Fluid::MODEL_NOT_SET;
   if (s.solid().model_case() != scene::Solid::MODEL_NOT_SET && rules.solid.stable_step) {
-    if (s.solid().has_mpm() && rules.solid.size) {
-      const auto size = rules.solid.size(s);
-      cost.particles = particles > 0 ? particles : size.particles;
-      cost.nodes = size.nodes;
+    if (rules.solid.size) {
+      solid_size = rules.solid.size(s);
+      if (solid_size.particles > 0) cost.particles = particles > 0 ? particles : solid_size.particles;
+      cost.nodes = solid_size.nodes;
     }
     const auto step = rules.solid.stable_step(s);
     stable = step.dt_s;
     cost.dt_from = step.source;
   }
-  if (s.has_fluid() && s.fluid().model_case() != scene::Fluid::MODEL_NOT_SET && rules.fluid.stable_step) {
+  if (fluid && rules.fluid.size) fluid_size = rules.fluid.size(s);
+  if (fluid && rules.fluid.stable_step) {
     const auto step = rules.fluid.stable_step(s);
     const double f = step.dt_s;
     if (step.known && f > 0 && (!(stable > 0) || f < stable)) {
@@ -74,23 +66,15 @@ RunCost estimate_run_cost(const scene::Scene& s, const proto::SceneRules& rules,
   cost.steps = std::ceil(s.time().end_s() / cost.dt);
   double per_step = 0;
   std::string basis;
-  if (s.solid().has_mpm()) {
-    per_step += cost.particles / kSolidParticleStepsPerS;
-    basis = "MPM solid " + number(kSolidParticleStepsPerS / 1e6, 2) + " M particle-steps/s";
-  } else {
-    per_step += kStandInStepS;
-    basis = "stand-in solid " + number(kStandInStepS * 1e6, 2) + " us/step";
-  }
-  if (s.has_fluid() && s.fluid().has_mpm()) {
-    const bool implicit = s.coupling().scheme() == scene::Coupling::IMPLICIT;
-    per_step += implicit ? kImplicitFluidStepS : kExplicitFluidStepS;
-    basis += std::string(", MPM fluid and exchange ") +
-             number((implicit ? kImplicitFluidStepS : kExplicitFluidStepS) * 1e3, 2) + " ms/step (" +
-             (implicit ? "implicit interface" : "explicit") + ")";
-  } else if (s.has_fluid()) {
-    per_step += kStandInStepS;
-    basis += ", stand-in fluid " + number(kStandInStepS * 1e6, 2) + " us/step";
-  }
+  // Each side's wall time per step: its own figure, for its particles (the
+  // solid's: the caller's count if given).
+  auto add = [&](const proto::SceneSize& size, double side_particles) {
+    per_step += size.step_s;
+    if (size.particle_steps_per_s > 0) per_step += side_particles / size.particle_steps_per_s;
+    if (!size.throughput.empty()) basis += (basis.empty() ? "" : ", ") + size.throughput;
+  };
+  add(solid_size, cost.particles);
+  add(fluid_size, fluid_size.particles);
   cost.wall_s = cost.steps * per_step;
   cost.basis = basis + "; measured on kgd-viscosity, quiet 2-core machine (docs/performance.md)";
   return cost;

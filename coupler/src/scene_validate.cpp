@@ -6,7 +6,6 @@
 // (hfmpm/proto/scene_rules.hpp), handed over by the program that links it.
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/proto/scene_rules.hpp"
@@ -34,13 +33,23 @@ void check_time(Checker& c, const scene::Scene& s) {
   c.range("output.interval_s", s.output().interval_s(), 0, upper, false, "s, 0 for end_s / 100");
   c.range("output.checkpoint_interval_s", s.output().checkpoint_interval_s(), 0, upper, false,
           "s, 0 for no checkpoints");
-  if (s.output().checkpoint_interval_s() > 0 &&
-      ((s.has_solid() && s.solid().has_prescribed_crack()) || (s.has_fluid() && s.fluid().has_prescribed_pressure()))) {
-    std::ostringstream value;
-    value << s.output().checkpoint_interval_s();
-    c.bad("output.checkpoint_interval_s", value.str(),
-          "0 with a stand-in side (solid.prescribed_crack, fluid.prescribed_pressure): the stand-ins do not write "
-          "checkpoints; only the MPM sides do");
+}
+
+// Checkpoints need both sides to write them: each side's rules say whether
+// its model in this scene does (SideSceneRules::checkpoint_refusal).
+void check_checkpoints(Checker& c, const scene::Scene& s, const SceneRules& rules) {
+  if (!(s.output().checkpoint_interval_s() > 0)) return;
+  std::string refusals;
+  auto ask = [&](const SideSceneRules& side) {
+    if (!side.checkpoint_refusal) return;
+    const std::string why = side.checkpoint_refusal(s);
+    if (!why.empty()) refusals += (refusals.empty() ? "" : "; ") + why;
+  };
+  if (s.has_solid() && s.solid().model_case() != scene::Solid::MODEL_NOT_SET) ask(rules.solid);
+  if (s.has_fluid() && s.fluid().model_case() != scene::Fluid::MODEL_NOT_SET) ask(rules.fluid);
+  if (!refusals.empty()) {
+    c.bad("output.checkpoint_interval_s", text(s.output().checkpoint_interval_s()),
+          "0 with this scene's sides, which must both write checkpoints: " + refusals);
   }
 }
 
@@ -158,6 +167,7 @@ std::vector<SceneProblem> validate(const scene::Scene& s, const SceneRules& rule
   Checker c;
   check_name(c, s);
   check_time(c, s);
+  check_checkpoints(c, s, rules);
   check_coupling(c, s.coupling());
   if (!s.has_solid() || s.solid().model_case() == scene::Solid::MODEL_NOT_SET) {
     c.missing("solid", "a solid model: solid { mpm { ... } } or solid { prescribed_crack { ... } }");

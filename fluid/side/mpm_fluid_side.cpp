@@ -28,8 +28,7 @@ class MpmFluidSide final : public coupling::SideModel {
       throw coupling::InputError(message);
     }
     const auto& f = scene.fluid().mpm();
-    config_ = to_fluid_config(f);
-    config_.implicit_interface = scene.coupling().scheme() == scene::Coupling::IMPLICIT;
+    config_ = to_fluid_config(scene);
     try {
       mpm::FluidSolver check(config_);  // the library's own range checks, before any crack arrives
     } catch (const std::invalid_argument& e) {
@@ -233,8 +232,10 @@ class MpmFluidSide final : public coupling::SideModel {
 
 }  // namespace
 
-mpm::FluidConfig to_fluid_config(const scene::MpmFluid& f) {
+mpm::FluidConfig to_fluid_config(const scene::Scene& scene) {
+  const scene::MpmFluid& f = scene.fluid().mpm();
   mpm::FluidConfig c;
+  c.implicit_interface = scene.coupling().scheme() == scene::Coupling::IMPLICIT;
   c.density = f.density_kg_m3();
   c.bulk_modulus = f.bulk_modulus_pa();
   c.tait_c = f.tait_c();

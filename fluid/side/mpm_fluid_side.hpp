@@ -12,7 +12,10 @@ namespace hfmpm::fluid {
 inline const char* kMpmFluidName = "hfmpm-fluid";
 std::unique_ptr<coupling::SideModel> make_mpm_fluid_side();
 
-// The solver configuration a validated fluid.mpm block describes (exposed for tests).
-mpm::FluidConfig to_fluid_config(const scene::MpmFluid& scene);
+// The solver configuration a validated scene's fluid.mpm block (and its
+// coupling.scheme) describes. Every member a scene key stands for is set
+// from the scene, so an omitted key gives the schema's default, never
+// FluidConfig's (docs/architecture.md, "Defaults"; tests/unit/config_defaults_test.cpp).
+mpm::FluidConfig to_fluid_config(const scene::Scene& scene);
 
 }  // namespace hfmpm::fluid

@@ -1,7 +1,7 @@
 // The fluid side's scene rules (fluid_scene_rules.hpp):
 // fluid.prescribed_pressure here, fluid.mpm in scene_rules_mpm.cpp; and the
-// SideSceneRules that hands them and the stable step to the coupler's
-// validation.
+// SideSceneRules that hands them, the stable step, the cost per step and
+// whether the model writes checkpoints to the coupler's validation.
 #include <cmath>
 #include <string>
 
@@ -49,8 +49,42 @@ proto::SceneStep stable_step(const scene::Scene& s) {
   return step;
 }
 
+// Wall time per coupled step on the reference machine (docs/performance.md,
+// "Water: the implicit interface scheme's cost" and the quiet-machine table):
+// the MPM fluid and the exchange in kgd-viscosity's runs over 12,172 steps,
+// explicit (Gauss-Seidel, 2 MPa) 3.2 s + 1.7 s, implicit interface (water)
+// 17.4 s + 2.1 s.
+constexpr double kExplicitMpmStepS = (3.2 + 1.7) / 12172;
+constexpr double kImplicitMpmStepS = (17.4 + 2.1) / 12172;
+// The stand-in's step and the exchange (protocol cost only).
+constexpr double kPrescribedStepS = 150e-6;
+
+// No particles before it runs (they enter at the inlet); the cost per step.
+proto::SceneSize size(const scene::Scene& s) {
+  proto::SceneSize size;
+  if (s.fluid().has_prescribed_pressure()) {
+    size.step_s = kPrescribedStepS;
+    size.throughput = "stand-in fluid " + proto::text(kPrescribedStepS * 1e6, 2) + " us/step";
+  } else if (s.fluid().has_mpm()) {
+    const bool implicit = s.coupling().scheme() == scene::Coupling::IMPLICIT;
+    size.step_s = implicit ? kImplicitMpmStepS : kExplicitMpmStepS;
+    size.throughput = "MPM fluid and exchange " + proto::text(size.step_s * 1e3, 2) + " ms/step (" +
+                      (implicit ? "implicit interface" : "explicit") + ")";
+  }
+  return size;
+}
+
+// The MPM fluid writes checkpoints (MpmFluidSide::save_checkpoint); the
+// stand-in does not.
+std::string checkpoint_refusal(const scene::Scene& s) {
+  if (s.fluid().has_prescribed_pressure()) {
+    return "fluid.prescribed_pressure does not write checkpoints (fluid.mpm does)";
+  }
+  return "";
+}
+
 }  // namespace
 
-proto::SideSceneRules scene_rules() { return {check_fluid, stable_step, {}}; }
+proto::SideSceneRules scene_rules() { return {check_fluid, stable_step, size, checkpoint_refusal}; }
 
 }  // namespace hfmpm::fluid

@@ -11,7 +11,10 @@ namespace hfmpm::solid {
 inline const char* kMpmSolidName = "hfmpm-solid";
 std::unique_ptr<coupling::SideModel> make_mpm_solid_side();
 
-// The solver configuration a validated scene describes (exposed for tests).
+// The solver configuration a validated solid.mpm block describes. Every
+// member a scene key stands for is set from the scene, so an omitted key
+// gives the schema's default, never SolidConfig's (threads: 2, not 1;
+// docs/architecture.md, "Defaults"; tests/unit/config_defaults_test.cpp).
 mpm::SolidConfig to_solid_config(const scene::MpmSolid& scene);
 
 }  // namespace hfmpm::solid

@@ -1,6 +1,7 @@
 // The solid side's scene rules (solid_scene_rules.hpp): solid.prescribed_crack
 // here, solid.mpm in scene_rules_mpm.cpp; and the SideSceneRules that hands
-// them, the stable step and the size to the coupler's validation.
+// them, the stable step, the size and the cost per step, and whether the
+// model writes checkpoints to the coupler's validation.
 #include <cmath>
 #include <string>
 
@@ -75,13 +76,39 @@ proto::SceneStep stable_step(const scene::Scene& s) {
   return step;
 }
 
+// Wall time per coupled step on the reference machine (docs/performance.md,
+// "Water: the implicit interface scheme's cost" and the quiet-machine table:
+// kgd-viscosity, 10 s, 12,172 steps, quiet 2-core machine, 3 December).
+// The MPM solid inside a coupled run, 2 threads: kgd-viscosity's 55.6 s of
+// solid compute for its 39,275 particles over 12,172 steps (a crack, J every
+// check, 2 x 2 particles per cell near it).
+constexpr double kMpmParticleStepsPerS = 39275.0 * 12172 / 55.6;
+// The stand-in's step and the exchange (protocol cost only).
+constexpr double kPrescribedStepS = 150e-6;
+
 proto::SceneSize size(const scene::Scene& s) {
-  if (!s.solid().has_mpm()) return {};
-  return {mpm_solid_particles(s.solid().mpm()), mpm_solid_nodes(s.solid().mpm())};
+  proto::SceneSize size;
+  if (s.solid().has_prescribed_crack()) {
+    size.step_s = kPrescribedStepS;
+    size.throughput = "stand-in solid " + text(kPrescribedStepS * 1e6, 2) + " us/step";
+  } else if (s.solid().has_mpm()) {
+    size.particles = mpm_solid_particles(s.solid().mpm());
+    size.nodes = mpm_solid_nodes(s.solid().mpm());
+    size.particle_steps_per_s = kMpmParticleStepsPerS;
+    size.throughput = "MPM solid " + text(kMpmParticleStepsPerS / 1e6, 2) + " M particle-steps/s";
+  }
+  return size;
+}
+
+// The MPM solid writes checkpoints (MpmSolidSide::save_checkpoint); the
+// stand-in does not.
+std::string checkpoint_refusal(const scene::Scene& s) {
+  if (s.solid().has_prescribed_crack()) return "solid.prescribed_crack does not write checkpoints (solid.mpm does)";
+  return "";
 }
 
 }  // namespace
 
-proto::SideSceneRules scene_rules() { return {check_solid, stable_step, size}; }
+proto::SideSceneRules scene_rules() { return {check_solid, stable_step, size, checkpoint_refusal}; }
 
 }  // namespace hfmpm::solid

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <functional>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -36,6 +37,13 @@ inline constexpr double kInf = std::numeric_limits<double>::infinity();
 inline std::string text(double v) {
   std::ostringstream out;
   out << v;
+  return out.str();
+}
+
+// v with `significant` digits, as printf's %.*g.
+inline std::string text(double v, int significant) {
+  std::ostringstream out;
+  out << std::setprecision(significant) << v;
   return out.str();
 }
 
@@ -86,10 +94,16 @@ struct SceneStep {
   std::string hint;    // what to check if dt_s is not a positive finite number: " (check the ...)"
 };
 
-// What a side's model costs, from the scene alone (0: nothing to count).
+// What a side's model costs, from the scene alone (0: nothing to count):
+// its size, and its wall time per coupled step on the project's reference
+// machine (a quiet 2-core machine, docs/performance.md): step_s, plus one
+// particle step at particle_steps_per_s for each of its particles.
 struct SceneSize {
-  double particles = 0;  // an upper bound on the particles it makes
-  double nodes = 0;      // grid nodes
+  double particles = 0;             // an upper bound on the particles it makes
+  double nodes = 0;                 // grid nodes
+  double step_s = 0;                // s per coupled step (its own step and its exchange), apart from its particles
+  double particle_steps_per_s = 0;  // its throughput per particle (0: none)
+  std::string throughput;           // the figure in words: "MPM solid 8.6 M particle-steps/s"
 };
 
 // One side's rules for its block of the scene (solid.* or fluid.*), given a
@@ -98,6 +112,13 @@ struct SideSceneRules {
   std::function<void(Checker&, const scene::Scene&)> check;
   std::function<SceneStep(const scene::Scene&)> stable_step;
   std::function<SceneSize(const scene::Scene&)> size;
+  // Whether the side's model in this scene writes checkpoints and restarts
+  // from them (output.checkpoint_interval_s > 0 needs both sides to): "" if
+  // it does, else what does not and what would, naming its block
+  // ("solid.prescribed_crack does not write checkpoints (solid.mpm does)").
+  // Unset: the scene does not tell; the side's Hello (the capability
+  // "checkpoint") decides when it joins.
+  std::function<std::string(const scene::Scene&)> checkpoint_refusal;
 };
 
 // The rules of both sides, for the coupler's validation.

@@ -1,5 +1,9 @@
 // What a fluid simulation on one crack is built from. Plain C++; the side
-// adapter fills it from the scene. SI units, 2D per unit thickness.
+// adapter fills it from the scene. SI units, 2D per unit thickness. The
+// member defaults are the library's, for programs and tests that build a
+// config themselves, and equal the scene schema's (proto/hfmpm/scene.proto),
+// which the adapter's to_fluid_config sets for every member a scene key
+// stands for (docs/architecture.md, "Defaults").
 #pragma once
 
 #include <memory>

@@ -1,6 +1,10 @@
 // What an MPM solid is built from: grid, materials, regions (bonded into one
 // body), constraints, edge tractions, silent edges, damping. Plain C++; the
-// side adapter fills it from the scene.
+// side adapter fills it from the scene. The member defaults are the
+// library's, for programs and tests that build a config themselves; a run's
+// defaults are the scene schema's (proto/hfmpm/scene.proto), which the
+// adapter's to_solid_config sets for every member a scene key stands for.
+// They agree but for threads (docs/architecture.md, "Defaults").
 #pragma once
 
 #include <cstdint>
@@ -123,7 +127,7 @@ struct SolidConfig {
   // field) and the in-situ stress the first row of particles along a grown
   // crack loses as the tip passes (docs/solid.md).
   bool in_situ_reference = false;
-  int threads = 1;
+  int threads = 1;  // the scene's default is 2 (solid.mpm.threads)
 };
 
 }  // namespace hfmpm::solid::mpm
