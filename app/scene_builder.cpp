@@ -25,6 +25,14 @@ std::string num(double v) {
   return buffer;
 }
 
+// Grid and region bounds: whole (or half) multiples of the cell, written with
+// 12 digits so that the scene's own check of whole cells holds (6 lost it).
+std::string exact(double v) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
 // For the comments: three significant digits.
 std::string approx(double v) {
   char buffer[32];
@@ -197,6 +205,12 @@ BuiltScene build_scene(const problem::Problem& p) {
   // The cell: cells_per_half_length along the expected final half-length, and
   // at least two cells along the notch (the fluid's first grid).
   d.cell = significant(std::min(l_end / cells_per_l, 0.5 * p.notch_m()), 3, true);
+  if (l_end / d.cell > 200) {
+    throw ProblemError({"notch_m = " + num(p.notch_m()) + " needs cells of " + num(d.cell) +
+                        " m (two along the notch), " + num(std::floor(l_end / d.cell)) +
+                        " along the expected half-length of " + num(l_end) +
+                        " m; allowed: at most 200, notch_m >= " + num(l_end / 100) + " m"});
+  }
   const double h = d.cell;
   const double reach = box * l_end;
   d.cells_x = static_cast<int>(std::ceil(reach / h));
@@ -282,17 +296,17 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "output { interval_s: " << num(t_end / 20) << " }\n"
     << "coupling { transport: IPC scheme: IMPLICIT exchange_interval: 1 control_interval: 20 }\n"
     << "solid {\n  mpm {\n"
-    << "    grid { x_min_m: 0 y_min_m: " << num(-grid_y) << " x_max_m: " << num(grid_x) << " y_max_m: " << num(grid_y)
-    << " }\n"
-    << "    cell_size_m: " << num(h) << "\n"
+    << "    grid { x_min_m: 0 y_min_m: " << exact(-grid_y) << " x_max_m: " << exact(grid_x)
+    << " y_max_m: " << exact(grid_y) << " }\n"
+    << "    cell_size_m: " << exact(h) << "\n"
     << "    materials { name: \"rock\" youngs_modulus_pa: " << num(e) << " poisson_ratio: " << num(nu)
     << " density_kg_m3: " << num(density) << " toughness_pa_sqrt_m: " << num(rock.toughness_pa_sqrt_m()) << " }\n";
   const std::string stress = "initial_stress { xx_pa: " + num(-sigma_a) + " yy_pa: " + num(-sigma_n) + " }";
-  s << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << num(-body_y)
-    << " x_max_m: " << num(body_x) << " y_max_m: " << num(body_y) << " }\n              " << stress
+  s << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << exact(-body_y)
+    << " x_max_m: " << exact(body_x) << " y_max_m: " << exact(body_y) << " }\n              " << stress
     << " particles_per_cell: 1 }\n"
-    << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << num(-near_body_y)
-    << " x_max_m: " << num(near_body_x) << " y_max_m: " << num(near_body_y) << " }\n              " << stress
+    << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << exact(-near_body_y)
+    << " x_max_m: " << exact(near_body_x) << " y_max_m: " << exact(near_body_y) << " }\n              " << stress
     << " particles_per_cell: 2 }\n"
     << "    constraints { symmetry_x_m: 0 }\n"
     << "    tractions { edge: RIGHT normal_pa { constant: " << num(-sigma_a) << " } }\n"

@@ -134,6 +134,45 @@ TEST(SceneBuilder, ToughnessDominatedSceneTakesTheToughnessClosure) {
   EXPECT_DOUBLE_EQ(mpm.regions(0).initial_stress().xx_pa(), -2e5);
 }
 
+// Any valid problem gives a scene the coupler and both sides accept. A sweep
+// over rock, toughness, scale and resolution: the grid bounds are whole cells
+// from the minimum (with 6 digits they were not for a cell of 0.00977 m, and
+// the scene was refused).
+TEST(SceneBuilder, EveryProblemOfASweepGivesAValidScene) {
+  int built = 0;
+  for (const double e : {5e6, 1e7, 2e10, 3e10}) {
+    for (const double k_ic : {1e2, 3e4, 1e6}) {
+      for (const double cells : {8.0, 13.0, 20.0, 37.0}) {
+        for (const bool field : {false, true}) {
+          problem::Problem p = field ? field_problem() : toughness_problem();
+          p.mutable_rock()->set_youngs_modulus_pa(e);
+          p.mutable_rock()->set_toughness_pa_sqrt_m(k_ic);
+          p.mutable_accuracy()->set_cells_per_half_length(cells);
+          // A notch of a sixth of the expected final half-length (the shorter vertex's).
+          const double e_prime = e / (1 - 0.0625), t = p.duration_s() - 0.5 * p.injection().ramp_s();
+          const double q = p.injection().total_rate_m2_s(), mu = p.fluid().viscosity_pa_s();
+          p.set_notch_m(std::min(m_vertex(e_prime, mu, q, t).half_length, k_vertex(e_prime, k_ic, q, t).half_length) /
+                        6);
+          SCOPED_TRACE(std::to_string(e) + " " + std::to_string(k_ic) + " " + std::to_string(cells));
+          EXPECT_NO_THROW(checked(build_scene(p)));
+          ++built;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(built, 96);
+  // A notch so short that two cells along it would put more than 200 along the crack.
+  problem::Problem tiny = field_problem();
+  tiny.set_notch_m(0.01);
+  try {
+    build_scene(tiny);
+    FAIL() << "a notch needing 4,000 cells along the crack was accepted";
+  } catch (const ProblemError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("notch_m = 0.01 needs cells of 0.005 m"));
+    EXPECT_THAT(e.what(), HasSubstr("allowed: at most 200, notch_m >= 0.198"));
+  }
+}
+
 // The same physics asked for finer resolution gets a finer cell in proportion.
 TEST(SceneBuilder, AccuracySetsTheCell) {
   problem::Problem p = field_problem();
