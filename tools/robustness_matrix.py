@@ -165,7 +165,10 @@ def main():
             r = subprocess.run([HFMPM, "run", base + ".scene", "--out", run, "--quiet"], capture_output=True, text=True)
             row["wall_s"] = f"{time.time() - start:.1f}"
             if r.returncode != 0:
-                row.update(status="failed: " + (r.stderr.strip().splitlines() or ["?"])[-1], vertex="")
+                lines = r.stderr.strip().splitlines() or ["?"]
+                failed = [x for x in lines if "run failed:" in x]
+                row.update(status="failed: " + (failed[0].split("run failed:", 1)[1].strip() if failed else lines[-1]),
+                           vertex="")
             else:
                 km, vertex, worst, _ = judge(run, c)
                 row.update(status="completed", vertex=vertex)
