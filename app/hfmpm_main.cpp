@@ -191,6 +191,7 @@ int build_scene_command(const std::vector<std::string>& args) {
   // here with their rules, so that a builder bug cannot reach a run.
   const coupling::SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
   const scene::Scene checked = coupling::parse_scene(built.text, problem_path + " (built scene)", rules);
+  for (const auto& caution : built.derived.cautions) std::cerr << "hfmpm: caution: " << caution << "\n";
   if (out.empty()) {
     std::cout << built.text;
     return 0;

@@ -242,6 +242,24 @@ BuiltScene build_scene(const problem::Problem& p) {
   const double t_3 = t_eff * std::pow(std::min(1.0, 3 * p.notch_m() / l_end), 1.5);
   d.damping = significant(std::min(2 * omega, 0.02 * omega * omega * t_3), 2, true);
 
+  // Cautions from the robustness matrix: at high confinement against the net
+  // pressure the fluid's suction near its front (bounded only by cavitation
+  // at -sigma_n) closed the tip and stalled it (stopped at 78 and 300 times,
+  // completed up to 45 times); with the net pressure above the confinement
+  // the fluid lag is not small, which the zero-lag closures assume (the
+  // Km = 100 cases, at 0.1, stopped).
+  const double ratio = sigma_n / d.end.net_pressure;
+  if (ratio > 50) {
+    d.cautions.push_back("the confining stress is " + approx(ratio) +
+                         " times the expected net pressure: above 50 the near-front suction closed the tip and "
+                         "stalled it in the robustness matrix (docs/verification.md)");
+  }
+  if (ratio < 1) {
+    d.cautions.push_back("the expected net pressure is " + approx(1 / ratio) +
+                         " times the confining stress: the fluid lag is then not small, the zero-lag closure does "
+                         "not hold, and such runs stopped in the robustness matrix (docs/verification.md)");
+  }
+
   // Grid: the crack on y = 0 between node rows; two empty cells beyond the body.
   const int nx = d.cells_x, ny = d.cells_y_half;
   const double body_x = nx * h, body_y = (ny + 0.5) * h;
@@ -289,6 +307,7 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "#   virtual opening " << approx(d.virtual_opening) << " m: 1% of the expected final mouth opening.\n"
     << "#   ramp " << approx(ramp) << " s" << (p.injection().has_ramp_s() ? "" : " (1% of the duration)")
     << ": no water hammer at the start.\n";
+  for (const auto& caution : d.cautions) s << "# caution: " << caution << "\n";
   if (p.has_description()) s << "# " << p.description() << "\n";
   s << "name: \"" << p.name() << "\"\n"
     << "description: \"KGD from physics: " << regime << ", Km = " << num(d.km) << "\"\n"

@@ -43,6 +43,10 @@ struct Derived {
   double virtual_opening = 0;  // m
   double damping = 0;          // 1/s, the grid's mass-proportional damping
   int cells_x = 0, cells_y_half = 0;
+  // Where the robustness matrix (docs/verification.md, "Scenes from physics
+  // alone") saw runs like this one stall or stop: one line each, also in the
+  // scene's comments. Empty: inside what the matrix ran to completion.
+  std::vector<std::string> cautions;
 };
 
 struct BuiltScene {

@@ -173,6 +173,22 @@ TEST(SceneBuilder, EveryProblemOfASweepGivesAValidScene) {
   }
 }
 
+// The builder says where the robustness matrix saw such runs stall or stop:
+// confinement above 50 times the expected net pressure, or below it.
+TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
+  EXPECT_TRUE(build_scene(field_problem()).derived.cautions.empty());  // 15 times
+  problem::Problem deep = field_problem();
+  deep.mutable_in_situ()->set_normal_to_crack_pa(2e7);  // 300 times
+  const BuiltScene built = build_scene(deep);
+  ASSERT_EQ(built.derived.cautions.size(), 1u);
+  EXPECT_THAT(built.derived.cautions[0], HasSubstr("the confining stress is 300 times the expected net pressure"));
+  EXPECT_THAT(built.text, HasSubstr("# caution: the confining stress is 300 times"));
+  problem::Problem shallow = toughness_problem();
+  shallow.mutable_in_situ()->set_normal_to_crack_pa(1e4);  // the K-vertex's 17.8 kPa against 10 kPa
+  ASSERT_EQ(build_scene(shallow).derived.cautions.size(), 1u);
+  EXPECT_THAT(build_scene(shallow).derived.cautions[0], HasSubstr("the fluid lag is then not small"));
+}
+
 // The same physics asked for finer resolution gets a finer cell in proportion.
 TEST(SceneBuilder, AccuracySetsTheCell) {
   problem::Problem p = field_problem();
