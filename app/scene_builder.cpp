@@ -214,7 +214,6 @@ BuiltScene build_scene(const problem::Problem& p) {
   const double h = d.cell;
   const double reach = box * l_end;
   d.cells_x = static_cast<int>(std::ceil(reach / h));
-  d.cells_y_half = d.cells_x;
   const double density = rock.density_kg_m3();
   const double p_modulus = e * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
   const double c_p = std::sqrt(p_modulus / density), c_s = std::sqrt(e / (2 * (1 + nu)) / density);
@@ -261,7 +260,7 @@ BuiltScene build_scene(const problem::Problem& p) {
   }
 
   // Grid: the crack on y = 0 between node rows; two empty cells beyond the body.
-  const int nx = d.cells_x, ny = d.cells_y_half;
+  const int nx = d.cells_x, ny = d.cells_x;  // the body reaches as far across the crack as along it
   const double body_x = nx * h, body_y = (ny + 0.5) * h;
   const double grid_x = (nx + 2) * h, grid_y = (ny + 2.5) * h;
   // 2 x 2 particles per cell within 2 l x +-l of the crack, one beyond: the coarse far field
@@ -269,7 +268,6 @@ BuiltScene build_scene(const problem::Problem& p) {
   const int near_x = std::min(nx, static_cast<int>(std::ceil(2 * l_end / h)));
   const int near_y = std::min(ny, static_cast<int>(std::ceil(l_end / h)));
   const double near_body_x = near_x * h, near_body_y = (near_y + 0.5) * h;
-  const double scaled_cp = scaled_c;
 
   std::ostringstream s;
   const std::string regime =
@@ -287,12 +285,12 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "#   body " << approx(body_x) << " m x +-" << approx(body_y) << " m: " << approx(box)
     << " final half-lengths beyond the crack; 2 x 2 particles per cell within 2 x +-1 of\n"
     << "#   them around the crack, one beyond.\n"
-    << "#   density_scaling " << approx(d.density_scaling) << ": the scaled P-wave (" << approx(scaled_cp)
-    << " m/s) crosses the final half-length in " << approx(100 * l_end / scaled_cp / t_end)
+    << "#   density_scaling " << approx(d.density_scaling) << ": the scaled P-wave (" << approx(scaled_c)
+    << " m/s) crosses the final half-length in " << approx(100 * l_end / scaled_c / t_end)
     << "% of the injection time\n"
     << "#   (target 0.5%"
     << (settle > 0 ? "; with toughness, the settling wait may not cap the tip below 2x its speed" : "")
-    << "), and outruns the tip's final speed " << approx(scaled_cp / v_tip) << "-fold.\n"
+    << "), and outruns the tip's final speed " << approx(scaled_c / v_tip) << "-fold.\n"
     << "#   coupling IMPLICIT: the fluid's pressure is solved with the crack's opening, so any fluid\n"
     << "#   (water too) runs at the solid's step, which the program chooses (safety 0.9).\n"
     << "#   closure: "
