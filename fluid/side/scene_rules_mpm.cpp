@@ -55,7 +55,7 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   c.positive(key + "min_width_m", f.min_width_m(), "m");
   c.non_negative(key + "virtual_opening_m", f.virtual_opening_m(), "m");
   if (f.lag() == scene::MpmFluid::LAG_UNSPECIFIED)
-    c.bad(key + "lag", "LAG_UNSPECIFIED", "ZERO_PRESSURE, FRONT_PRESSURE or FIXED_PRESSURE");
+    c.bad(key + "lag", "LAG_UNSPECIFIED", "ZERO_PRESSURE, FRONT_PRESSURE, FIXED_PRESSURE or TIP_ASYMPTOTE");
   c.non_negative(key + "lag_pressure_pa", f.lag_pressure_pa(), "Pa");
   if (f.max_substeps() < 1 || f.max_substeps() > 100000) {
     c.bad(key + "max_substeps", std::to_string(f.max_substeps()), "1 to 100000 fluid steps per coupled step");

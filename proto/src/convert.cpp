@@ -2,6 +2,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hfmpm/proto/convert.hpp"
@@ -79,6 +80,8 @@ void to_proto(const CrackGeometry& crack, protocol::CrackState::Crack* out) {
     out->add_plane_acceleration_x(a.x());
     out->add_plane_acceleration_y(a.y());
   }
+  out->set_tip_modulus_pa(crack.tip_modulus);
+  out->set_resolution_m(crack.resolution);
 }
 
 CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
@@ -128,10 +131,17 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
       per_id("plane_acceleration_y", crack.plane_acceleration_y());
     }
   }
+  for (const auto& [name, value] : {std::pair<const char*, double>{"tip_modulus_pa", crack.tip_modulus_pa()},
+                                    {"resolution_m", crack.resolution_m()}}) {
+    if (!(value >= 0) || !std::isfinite(value))
+      fail(type, id, std::string(name) + " = " + std::to_string(value) + "; it must be finite and >= 0 (0: not sent)");
+  }
 
   CrackGeometry out;
   out.crack_id = id;
   out.grew = crack.grew();
+  out.tip_modulus = crack.tip_modulus_pa();
+  out.resolution = crack.resolution_m();
   out.ids.assign(crack.ids().begin(), crack.ids().end());
   out.width.assign(crack.width().begin(), crack.width().end());
   out.opening_rate.assign(crack.opening_rate().begin(), crack.opening_rate().end());

@@ -92,6 +92,9 @@ class MpmSolidSide final : public coupling::SideModel {
     for (std::size_t c = 0; c < solver_->cracks().size(); ++c) {
       const auto& crack = solver_->cracks()[c];
       auto g = geometry(crack);
+      // For a fluid's tip closure: E' where the crack ends, and the cell.
+      g.tip_modulus = solver_->plane_strain_modulus_at(crack.plane().back());
+      g.resolution = solver_->config().grid.h;
       if (implicit_) {  // the faces' response over the coming step, for the fluid's interface solve
         solver_->begin_step();
         auto r = solver_->face_response(c);

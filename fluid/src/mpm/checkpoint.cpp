@@ -75,6 +75,8 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("wall.compliance", wall_compliance_);
   out.put("wall.band", wall_band_);
   out.put("wall.plane_rate", wall_plane_rate_);
+  out.put("wall.tip_modulus", tip_modulus_);
+  out.put("wall.resolution", resolution_);
   out.put("wall.plane_acceleration", wall_plane_acceleration_);
   out.put("predicted_arc", predicted_arc_);
   out.put("solved", solved_);
@@ -144,6 +146,8 @@ void FluidSolver::load(const StateReader& in) {
   in.get("wall.compliance", wall_compliance_);
   in.get("wall.band", wall_band_);
   in.get("wall.plane_rate", wall_plane_rate_);
+  in.get("wall.tip_modulus", tip_modulus_);
+  in.get("wall.resolution", resolution_);
   in.get("wall.plane_acceleration", wall_plane_acceleration_);
   in.get("predicted_arc", predicted_arc_);
   in.get("solved", solved_);

@@ -96,6 +96,7 @@ void FluidSolver::pressure_force(const std::vector<double>& pp, double mouth, st
     force[hb.node + 1] += fb * hb.n1;
   }
   force[0] += mouth * grid_.width()[0];
+  front_force(force);
   if (outlet_wetted_) force[n - 1] -= std::max(0.0, config_.outlet.pressure(t_)) * grid_.width()[n - 1];
 }
 

@@ -71,7 +71,7 @@ void FluidSolver::project_pressure(const std::vector<double>& pp, std::vector<do
     const bool wetted = grid_.arc()[i] <= front && scratch[i] > 0;
     nodal[i] = wetted ? std::max(0.0, nodal[i] / scratch[i]) : 0.0;  // lag zone beyond the front
   }
-  if (config_.lag == FluidConfig::Lag::Fixed) {
+  if (config_.lag == FluidConfig::Lag::Fixed || config_.lag == FluidConfig::Lag::TipAsymptote) {
     for (std::size_t i = 0; i < n; ++i)
       if (grid_.arc()[i] > front) nodal[i] = config_.lag_pressure;
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 
@@ -74,6 +75,17 @@ void FluidSolver::set_crack(const CrackGeometry& crack) {
   wall_band_ = crack.compliance_band;
   wall_plane_rate_ = crack.plane_rate;
   wall_plane_acceleration_ = crack.plane_acceleration;
+  if (config_.lag == FluidConfig::Lag::TipAsymptote) {
+    if (!(crack.tip_modulus > 0) || !(crack.resolution > 0)) {
+      std::ostringstream out;
+      out << "fluid: crack " << crack.crack_id << ": lag TIP_ASYMPTOTE needs the solid's tip_modulus_pa and "
+          << "resolution_m (> 0) with the crack; got " << crack.tip_modulus << " Pa and " << crack.resolution
+          << " m (0: the solid side does not send them; use lag FIXED_PRESSURE with such a side)";
+      throw std::invalid_argument(out.str());
+    }
+    tip_modulus_ = crack.tip_modulus;
+    resolution_ = crack.resolution;
+  }
   const std::vector<double> carried = nodal_pressure_;  // what the faces carried over the last step
   if (particle_length_ == 0) {
     particle_length_ = config_.particle_length > 0 ? config_.particle_length : 0.5 * (grid_.arc()[1] - grid_.arc()[0]);
@@ -291,9 +303,40 @@ void FluidSolver::p2g() {
       force_[hb.node + 1] += fb * hb.n1;
     }
   }
+  front_force(force_);
   // Boundary pressures: the inlet at the mouth pushes in; a wetted outlet pushes back.
   force_[0] += mouth_pressure() * grid_.width()[0];
   if (outlet_wetted_) force_[n - 1] -= std::max(0.0, config_.outlet.pressure(t_)) * grid_.width()[n - 1];
+}
+
+double FluidSolver::front_counter_pressure() const {
+  const std::size_t np = particles_.size();
+  if (config_.lag != FluidConfig::Lag::TipAsymptote || np == 0) return 0.0;
+  // The zero-toughness, zero-lag tip solution of a crack running at V
+  // (Desroches et al. 1994; docs/fluid.md): w = beta_m (mu' V / E')^(1/3) s^(2/3)
+  // and, from the lubrication flux V w = -(w^3 / mu') dp/ds,
+  // p = -(3 / beta_m^2) (mu' V E'^2)^(1/3) s^(-1/3).
+  constexpr double kBetaSquared = 9.9054;  // beta_m^2 = 2^(2/3) 3^(5/3)
+  const std::size_t last = np - 1;
+  const double V = std::max(0.0, particles_.velocity[last]);
+  const double w = std::max(particles_.width[last], config_.min_width);
+  double k = 0;  // Pa s / m^2, the front particle's drag coefficient
+  rheology_->drag(std::span<const double>(&w, 1), std::span<const double>(&particles_.velocity[last], 1),
+                  std::span<double>(&k, 1));
+  const double mu_prime = k * w * w;  // 12 mu for a Newtonian fluid
+  const double suction =
+      3.0 / kBetaSquared * std::cbrt(mu_prime * V * tip_modulus_ * tip_modulus_) / std::cbrt(resolution_);
+  return std::max(0.0, config_.lag_pressure - suction);
+}
+
+void FluidSolver::front_force(std::vector<double>& force) const {
+  const double counter = front_counter_pressure();
+  if (!(counter > 0)) return;
+  const double b = particles_.end(particles_.size() - 1);
+  const HatPoint hb = hat_at(grid_.arc(), b);
+  const double fb = counter * grid_.width_at(b);
+  force[hb.node] -= fb * hb.n0;
+  force[hb.node + 1] -= fb * hb.n1;
 }
 
 void FluidSolver::check_compression() const {

@@ -35,6 +35,12 @@ struct CrackGeometry {
   // Optional with the response: the crack plane's motion, x(t + dt) = x + dt (plane_rate + dt plane_acceleration).
   std::vector<Vec2> plane_rate;          // m/s
   std::vector<Vec2> plane_acceleration;  // m/s^2
+  // Optional (0: not sent): what a fluid needs for a tip closure in the unresolved
+  // last cell (fluid lag TIP_ASYMPTOTE): the plane-strain modulus E' of the
+  // material at the crack's last point (the tip the fluid runs towards), and
+  // the length over which the solid resolves the faces' opening (its cell).
+  double tip_modulus = 0;  // Pa
+  double resolution = 0;   // m
 
   std::size_t size() const { return ids.size(); }
 };

@@ -88,9 +88,19 @@ struct FluidConfig {
   // pore pressure; or the confining stress as a zero-lag closure, so the dry
   // zone the grid cannot make small carries no net load; pair it with the
   // solid's fracture.max_lag_cells, or a crack with little toughness runs dry).
-  enum class Lag { Zero, Front, Fixed };
+  // TipAsymptote: the zero-lag closure of a viscosity-dominated crack whose
+  // last cell the solid does not resolve (docs/fluid.md, "The tip closure"):
+  // nodes beyond the front carry lag_pressure (the confining stress: no net
+  // load), and the fluid front meets, instead of a vacuum, the pressure of
+  // the zero-toughness tip solution at the solid's resolution d (one cell),
+  //   p_tip = max(0, lag_pressure - (3 / beta_m^2) (mu' V E'^2)^(1/3) d^(-1/3)),
+  // with beta_m = 2^(1/3) 3^(5/6), V the front's speed, mu' = k w^2 the
+  // front particle's drag coefficient times its width squared (12 mu for a
+  // Newtonian fluid), and E', d from the solid (CrackGeometry::tip_modulus,
+  // resolution; required).
+  enum class Lag { Zero, Front, Fixed, TipAsymptote };
   Lag lag = Lag::Zero;
-  double lag_pressure = 0;  // Pa, for Lag::Fixed
+  double lag_pressure = 0;  // Pa, for Lag::Fixed and Lag::TipAsymptote
   double min_width = 1e-9;  // m, width floor in the drag and in w0 (numerical; the drag is implicit)
   InletConfig inlet;
   OutletConfig outlet;

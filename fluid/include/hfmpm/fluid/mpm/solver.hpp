@@ -152,6 +152,9 @@ class FluidSolver {
   double frozen_width_rise() const;
   // m, arc length of the front (the end of the last particle), at most the crack length; 0 when empty.
   double front_position() const;
+  // Pa, the pressure beyond the front that the fluid front pushes against:
+  // 0 (a vacuum), or with Lag::TipAsymptote the tip solution's (config.hpp).
+  double front_counter_pressure() const;
   // Pa, the pressure held at the mouth: p_in(t), or for a flow-rate inlet
   // the inlet particle's pressure.
   double inlet_pressure() const;
@@ -207,6 +210,8 @@ class FluidSolver {
   // Residual P_e - p_Tait(V_e / V0_e) of element pressures P after a trial step of dt.
   bool interface_trial(const std::vector<double>& P, double dt, Trial& t, std::vector<double>& residual) const;
   void pressure_force(const std::vector<double>& pp, double mouth, std::vector<double>& force) const;
+  // The push of front_counter_pressure() back on the front end (a no-op when it is 0).
+  void front_force(std::vector<double>& force) const;
 
   FluidConfig config_;
   TaitEos eos_;
@@ -228,6 +233,7 @@ class FluidSolver {
   std::vector<double> wall_rate_, wall_acceleration_, wall_compliance_;  // from the solid (CrackGeometry)
   std::size_t wall_band_ = 0;
   std::vector<Vec2> wall_plane_rate_, wall_plane_acceleration_;  // the crack plane's motion (may be empty)
+  double tip_modulus_ = 0, resolution_ = 0;                      // Pa, m: from the solid, for Lag::TipAsymptote
   std::vector<double> predicted_arc_;                            // node arc lengths at the end of the step
   std::vector<double> solved_;  // Pa, the element pressures of the last implicit step (the next start)
   std::vector<std::vector<std::pair<std::size_t, double>>> pieces_;  // per particle: (element, fraction) now

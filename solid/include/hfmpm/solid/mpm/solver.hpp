@@ -126,6 +126,11 @@ class Solver {
   // J, K_I, K_II and the kink angle at every tip, evaluated now (one pass
   // over the particles near the tips). Quasi-static J: no kinetic terms.
   std::vector<TipResult> tips() const;
+  // Pa, the plane-strain modulus E' of the material at x (the region that
+  // holds x, else the nearest particle's).
+  double plane_strain_modulus_at(const Vec2& x) const {
+    return config_.materials[material_at(x)].plane_strain_modulus();
+  }
   // The tips as last evaluated by the propagation check (empty without one).
   const std::vector<TipResult>& last_tips() const { return last_tips_; }
   // Grows every tip whose J >= J_Ic by one crack particle in the maximum hoop
