@@ -223,7 +223,7 @@ BuiltScene build_scene(const problem::Problem& p) {
   // cell) must not cap the tip below twice the vertex's final speed.
   const double v_tip = 2.0 / 3.0 * l_end / t_end;
   double scaling = std::pow(c_p * 0.005 * t_end / l_end, 2);
-  const double growth = d.viscosity_dominated ? 0.5 : 0.25, settle = d.viscosity_dominated ? 0.0 : 2.0;
+  const double growth = 0.25, settle = d.viscosity_dominated ? 0.0 : 2.0;
   if (settle > 0) {
     const double c_s_needed = 2 * settle * l_end * v_tip / (growth * h);
     scaling = std::min(scaling, std::pow(c_s / c_s_needed, 2));
@@ -294,11 +294,13 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "#   coupling IMPLICIT: the fluid's pressure is solved with the crack's opening, so any fluid\n"
     << "#   (water too) runs at the solid's step, which the program chooses (safety 0.9).\n"
     << "#   closure: "
-    << (d.viscosity_dominated ? "the dry tip zone carries the confining stress normal to the crack (zero-lag),\n"
-                                "#   the tip waits for the fluid within 0.5 cell and grows by 0.5 cell.\n"
-                              : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
-                                "#   the tip waits for the fluid within 0.25 cell, grows by 0.25 cell and lets the "
-                                "opening follow (2 transits).\n")
+    << (d.viscosity_dominated
+            ? "the dry tip zone carries the confining stress normal to the crack and the fluid\n"
+              "#   front meets the zero-toughness tip solution's pressure one cell from the tip (zero lag);\n"
+              "#   the tip waits for the fluid within 0.25 cell and grows by 0.25 cell.\n"
+            : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
+              "#   the tip waits for the fluid within 0.25 cell, grows by 0.25 cell and lets the "
+              "opening follow (2 transits).\n")
     << "#   damping " << approx(d.damping) << " /s: critical for the body's lowest mode (" << approx(omega)
     << " rad/s) or less, so that the body lags a rising load by at most 2% of the time the crack\n"
     << "#   takes to three notch lengths (" << approx(t_3) << " s).\n"
@@ -348,7 +350,7 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "    initial_fill { front_m: " << num(p.notch_m()) << " pressure_pa: " << num(sigma_n) << " }\n"
     << "    virtual_opening_m: " << num(d.virtual_opening) << "\n";
   if (d.viscosity_dominated) {
-    s << "    lag: FIXED_PRESSURE lag_pressure_pa: " << num(sigma_n) << "\n";
+    s << "    lag: TIP_ASYMPTOTE lag_pressure_pa: " << num(sigma_n) << "\n";
   } else {
     s << "    lag: FRONT_PRESSURE\n";
   }

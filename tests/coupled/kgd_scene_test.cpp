@@ -178,16 +178,16 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
   EXPECT_GE(compared, 5);  // the crack reached three notch lengths by ~3.3 s
 }
 
-// Viscosity-dominated (Km = 0.023) against the M-vertex. Measured with the
-// in-situ stress as reference state (the scene's in_situ_reference): 9.3%,
-// 0.6% and 6.1% worst; the length's 9.3% is the first row (3 s), where the
-// tip leads the fluid front by about a cell (8% of the crack; the front is
-// within 1.6%), and falls to 3.9% at 5 s. (Before the reference state:
-// 7.4%, 5.4% and 3.4%. At h = 0.05 m the first row's length was 11.6% long,
-// which is why the CI scenes use 0.035 m; docs/verification.md, "Coupled KGD".)
+// Viscosity-dominated (Km = 0.023) against the M-vertex, with water, the
+// implicit scheme and the tip-asymptote closure (the scene's defaults since
+// issue 17). Measured: 7.3%, 4.1% and 4.0% worst (the length's 7.3% is the
+// first row, 3 s, where the tip leads the fluid front by its tip segment;
+// the front is within 1.8%). With the vacuum front (lag FIXED_PRESSURE) and
+// half-cell growth the same water run gave 15.9%, 0.5% and 3.9%, the front
+// 7.7% long (docs/verification.md, "The tip closure").
 TEST(KgdScene, ViscosityCiSceneFollowsTheMVertex) {
-  expect_ci_scene_follows("scenarios/kgd-viscosity-ci.scene", 2.5e-4,
-                          [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); });
+  expect_ci_scene_follows(
+      "scenarios/kgd-viscosity-ci.scene", 2.5e-4, [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9);
 }
 
 // Toughness-dominated (Km = 7.6) against the K-vertex. Measured: 6.4%, 1.7%
@@ -264,18 +264,17 @@ TEST(KgdScene, FieldScaleWaterCiSceneFollowsTheMVertex) {
 // The implicit interface scheme (coupling.scheme IMPLICIT, issue 17) on the
 // CI viscosity scene at its own step: the answer no longer depends on how
 // stiff the fluid is. At K = 2e7 Pa and water (2e9 Pa), from three notch
-// lengths on, the mouth opening, the net inlet pressure and the fluid front
-// agree within 2% at every row where the two tips have grown equally, and
-// within 3% where one tip is a growth increment (0.5 cell, 0.0175 m) ahead
-// (each growth step dips the pressure for a while); the tips differ by at
-// most one increment plus 2%. Against the M-vertex, water's opening is
-// within 10% and its net pressure within 20% (the CI bounds). Measured: 1.2%
-// (opening), 1.8% (pressure) and 0.6% (front) worst over the 10 rows; water
-// against the M-vertex 0.5% and 3.9%. (The tip's half-length runs 7-16% long
-// and its fluid front 3-8% at h = 0.035 m; 6-9% and 4-6% at h = 0.025 m: a
-// spatial error and the notch's memory, docs/verification.md; not asserted
-// here.) K = 2e6 Pa is left out on purpose: at 1.1e5 Pa it is compressed by
-// 5%, a physical difference (its opening is 2.9% from water's).
+// lengths on, the mouth opening and the net inlet pressure agree within 2%
+// at every row where the two tips have grown equally, and within 3% where
+// one tip is ahead (each growth step dips the pressure for a while); the
+// fluid fronts within 3%; the tips differ by at most two growth increments
+// (a quarter cell each, 0.00875 m) plus 2%. Against the M-vertex, water's
+// opening is within 10% and its net pressure within 20% (the CI bounds).
+// Measured with the tip-asymptote closure and quarter-cell growth: 1.7%
+// (opening), 2.3% (pressure, at a row where the tips differ) and 2.5% (front)
+// worst over 9 rows, the tips at most 0.016 m apart. K = 2e6 Pa is left out
+// on purpose: at 1.1e5 Pa it is compressed by 5%, a physical difference (its
+// opening was 2.9% from water's).
 TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
   struct Run {
     std::vector<double> t, length, front, mouth, p_in;
@@ -301,7 +300,7 @@ TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
   const Run soft = soft_run.get(), water = water_run.get();
   ASSERT_EQ(soft.t.size(), water.t.size());
   ASSERT_GE(water.t.size(), 20u);
-  constexpr double kSigma0 = 1e5, kNotch = 0.15, kGrowth = 0.0175;
+  constexpr double kSigma0 = 1e5, kNotch = 0.15, kGrowth = 0.00875;
   double worst_opening = 0, worst_pressure = 0, worst_front = 0;
   int compared = 0;
   for (std::size_t i = 0; i < water.t.size(); ++i) {
@@ -315,8 +314,8 @@ TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
     const double bound = std::abs(soft.length[i] - water.length[i]) < 0.5 * kGrowth ? 0.02 : 0.03;
     EXPECT_LT(opening, bound) << "t = " << water.t[i];
     EXPECT_LT(pressure, bound) << "t = " << water.t[i];
-    EXPECT_LT(front, 0.02) << "t = " << water.t[i];
-    EXPECT_LT(std::abs(soft.length[i] - water.length[i]), kGrowth + 0.02 * water.length[i]) << "t = " << water.t[i];
+    EXPECT_LT(front, 0.03) << "t = " << water.t[i];
+    EXPECT_LT(std::abs(soft.length[i] - water.length[i]), 2 * kGrowth + 0.02 * water.length[i]) << "t = " << water.t[i];
     const Vertex v = m_vertex(1e7, 0.25, 0.01, 2.5e-4, water.t[i] - 0.025);
     EXPECT_LT(std::abs(water.mouth[i] / v.opening - 1), 0.10) << "t = " << water.t[i];
     EXPECT_LT(std::abs((water.p_in[i] - kSigma0) / v.pressure - 1), 0.20) << "t = " << water.t[i];

@@ -102,9 +102,9 @@ TEST(SceneBuilder, ViscosityDominatedSceneFollowsItsDerivation) {
   EXPECT_LE(alpha / (omega * omega), 0.02 * t_3);
   EXPECT_GE(alpha / (omega * omega), 0.018 * t_3);  // the lag bound is the one that acts here
   // The viscous closure: the dry zone at the confining stress, the tip waiting for the fluid.
-  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FIXED_PRESSURE);
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE);
   EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e6);
-  EXPECT_DOUBLE_EQ(mpm.fracture().max_lag_cells(), 0.5);
+  EXPECT_DOUBLE_EQ(mpm.fracture().max_lag_cells(), 0.25);
   EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
   EXPECT_DOUBLE_EQ(s.fluid().mpm().bulk_modulus_pa(), 2e9);  // water by default
   // One wing: half the total rate, ramped.

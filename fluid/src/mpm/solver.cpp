@@ -316,7 +316,7 @@ double FluidSolver::front_counter_pressure() const {
   // (Desroches et al. 1994; docs/fluid.md): w = beta_m (mu' V / E')^(1/3) s^(2/3)
   // and, from the lubrication flux V w = -(w^3 / mu') dp/ds,
   // p = -(3 / beta_m^2) (mu' V E'^2)^(1/3) s^(-1/3).
-  constexpr double kBetaSquared = 9.9054;  // beta_m^2 = 2^(2/3) 3^(5/3)
+  constexpr double kBetaSquared = 9.9057817466838;  // beta_m^2 = 2^(2/3) 3^(5/3)
   const std::size_t last = np - 1;
   const double V = std::max(0.0, particles_.velocity[last]);
   const double w = std::max(particles_.width[last], config_.min_width);
