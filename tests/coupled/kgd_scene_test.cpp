@@ -157,7 +157,11 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
       EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
       const double ratio = volume[i] / (injected[i] + kInitial);
       EXPECT_GT(ratio, j_min) << "t = " << t[i];
-      EXPECT_LT(ratio, 1.0 + 1e-9) << "t = " << t[i];
+      // Above 1 only by a particle at zero pressure stretched past its rest
+      // volume (J > 1: the liquid cavitates rather than carry tension), whose
+      // domain then counts some empty crack: water's front particle early on
+      // (measured 1.0116 at 0.25 s, 1.0033 at 0.5 s, below 1.0001 from 0.75 s).
+      EXPECT_LT(ratio, t[i] < 1 ? 1.02 : 1.001) << "t = " << t[i];
     }
     if (length[i] < 3 * kNotch) continue;
     const Vertex v = reference(t[i] - 0.5 * kRamp);
@@ -267,12 +271,13 @@ TEST(KgdScene, FieldScaleWaterCiSceneFollowsTheMVertex) {
 // lengths on, the mouth opening and the net inlet pressure agree within 2%
 // at every row where the two tips have grown equally, and within 3% where
 // one tip is ahead (each growth step dips the pressure for a while); the
-// fluid fronts within 3%; the tips differ by at most two growth increments
+// fluid fronts within 2%; the tips differ by at most two growth increments
 // (a quarter cell each, 0.00875 m) plus 2%. Against the M-vertex, water's
 // opening is within 10% and its net pressure within 20% (the CI bounds).
-// Measured with the tip-asymptote closure and quarter-cell growth: 1.7%
-// (opening), 2.3% (pressure, at a row where the tips differ) and 2.5% (front)
-// worst over 9 rows, the tips at most 0.016 m apart. K = 2e6 Pa is left out
+// Measured with the tip-asymptote closure and quarter-cell growth: 0.6%
+// (opening), 0.8% (pressure) and 0.8% (front) worst over 9 rows, the tips at
+// most 0.0175 m apart (with the front particle's own velocity as the
+// closure's V instead of the last cell's mean: 3.1%, 3.5%, 3.6%). K = 2e6 Pa is left out
 // on purpose: at 1.1e5 Pa it is compressed by 5%, a physical difference (its
 // opening was 2.9% from water's).
 TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
@@ -314,7 +319,7 @@ TEST(KgdScene, ImplicitSchemeAnswerDoesNotDependOnTheFluidStiffness) {
     const double bound = std::abs(soft.length[i] - water.length[i]) < 0.5 * kGrowth ? 0.02 : 0.03;
     EXPECT_LT(opening, bound) << "t = " << water.t[i];
     EXPECT_LT(pressure, bound) << "t = " << water.t[i];
-    EXPECT_LT(front, 0.03) << "t = " << water.t[i];
+    EXPECT_LT(front, 0.02) << "t = " << water.t[i];
     EXPECT_LT(std::abs(soft.length[i] - water.length[i]), 2 * kGrowth + 0.02 * water.length[i]) << "t = " << water.t[i];
     const Vertex v = m_vertex(1e7, 0.25, 0.01, 2.5e-4, water.t[i] - 0.025);
     EXPECT_LT(std::abs(water.mouth[i] / v.opening - 1), 0.10) << "t = " << water.t[i];

@@ -318,11 +318,21 @@ double FluidSolver::front_counter_pressure() const {
   // p = -(3 / beta_m^2) (mu' V E'^2)^(1/3) s^(-1/3).
   constexpr double kBetaSquared = 9.9057817466838;  // beta_m^2 = 2^(2/3) 3^(5/3)
   const std::size_t last = np - 1;
-  const double V = std::max(0.0, particles_.velocity[last]);
+  // V: the mass-weighted mean velocity of the fluid within d of the front.
+  // (The front particle's own velocity jumps as particles merge and as it
+  // crosses into a new element: with it, two runs that differed only in the
+  // fluid's stiffness differed by 3% in opening and pressure, against 0.8%.)
+  const double front = particles_.end(last);
+  double m = 0, mv = 0;
+  for (std::size_t p = np; p-- > 0;) {
+    if (p < last && particles_.s[p] < front - resolution_) break;
+    m += particles_.mass[p];
+    mv += particles_.mass[p] * particles_.velocity[p];
+  }
+  const double V = std::max(0.0, mv / m);
   const double w = std::max(particles_.width[last], config_.min_width);
-  double k = 0;  // Pa s / m^2, the front particle's drag coefficient
-  rheology_->drag(std::span<const double>(&w, 1), std::span<const double>(&particles_.velocity[last], 1),
-                  std::span<double>(&k, 1));
+  double k = 0;  // Pa s / m^2, the drag coefficient at the front particle's width and speed V
+  rheology_->drag(std::span<const double>(&w, 1), std::span<const double>(&V, 1), std::span<double>(&k, 1));
   const double mu_prime = k * w * w;  // 12 mu for a Newtonian fluid
   const double suction =
       3.0 / kBetaSquared * std::cbrt(mu_prime * V * tip_modulus_ * tip_modulus_) / std::cbrt(resolution_);
