@@ -99,6 +99,31 @@ TEST(CrackGeometryConvert, NegativeWidthIsNamed) {
   EXPECT_THAT(text, HasSubstr(">= 0"));
 }
 
+// The tip closure's data (CrackState tip_modulus_pa, resolution_m): carried
+// exactly, absent as 0, and a negative or non-finite value named.
+TEST(CrackGeometryConvert, TipModulusAndResolutionRoundTripAndAreChecked) {
+  auto in = sample_geometry();
+  EXPECT_EQ(hfmpm::proto::from_proto([&] {
+              protocol::CrackState::Crack m;
+              hfmpm::proto::to_proto(in, &m);
+              return m;
+            }())
+                .tip_modulus,
+            0.0);
+  in.tip_modulus = 1.0666666666666667e7;
+  in.resolution = 0.035;
+  protocol::CrackState::Crack m;
+  hfmpm::proto::to_proto(in, &m);
+  const auto out = hfmpm::proto::from_proto(m);
+  EXPECT_EQ(out.tip_modulus, in.tip_modulus);
+  EXPECT_EQ(out.resolution, in.resolution);
+  m.set_tip_modulus_pa(-1);
+  EXPECT_THAT(from_proto_error(m), HasSubstr("tip_modulus_pa = -1"));
+  m.set_tip_modulus_pa(1e7);
+  m.set_resolution_m(std::numeric_limits<double>::infinity());
+  EXPECT_THAT(from_proto_error(m), HasSubstr("resolution_m = inf; it must be finite and >= 0"));
+}
+
 TEST(CrackGeometryConvert, FewerThanTwoParticlesIsRejected) {
   auto g = sample_geometry();
   g.crack_id = 5;
