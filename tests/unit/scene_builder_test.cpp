@@ -187,6 +187,15 @@ TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
   shallow.mutable_in_situ()->set_normal_to_crack_pa(1e4);  // the K-vertex's 17.8 kPa against 10 kPa
   ASSERT_EQ(build_scene(shallow).derived.cautions.size(), 1u);
   EXPECT_THAT(build_scene(shallow).derived.cautions[0], HasSubstr("the fluid lag is then not small"));
+  // A crack as wide as a sizeable part of its length (the matrix's lab Km = 100:
+  // K_Ic = 433 kPa m^0.5 in a 10 MPa rock opens 19 mm over 42 mm).
+  problem::Problem fat = toughness_problem();
+  fat.mutable_rock()->set_toughness_pa_sqrt_m(4.33e5);
+  fat.set_notch_m(0.02);  // its K-vertex grows to 0.094 m
+  const auto cautions = build_scene(fat).derived.cautions;
+  ASSERT_FALSE(cautions.empty());
+  EXPECT_THAT(cautions.back(), HasSubstr("% of the half-length: strains of that order are outside"));
+  EXPECT_EQ(build_scene(toughness_problem()).derived.cautions.size(), 0u);  // 2% of its half-length
 }
 
 // The same physics asked for finer resolution gets a finer cell in proportion.
