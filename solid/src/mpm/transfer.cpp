@@ -105,31 +105,39 @@ std::array<std::size_t, 2> Solver::p2g_band(std::size_t begin, std::size_t end) 
 // Mass, momentum, internal force (and, with cracks, the mass-weighted
 // displacement and each particle's side of the crack per node) of particles
 // [begin, end) into thread k's accumulator.
+//
+// The grid and the arrays are read through locals: the SSE2 stores may
+// alias anything, so members would be reloaded at every node.
 template <bool kCracks>
 void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
-  const auto& g = config_.grid;
+  const Grid g = config_.grid;
   constexpr std::size_t F = kCracks ? 2 : 1;
-  auto& acc = thread_acc_[k];
+  NodeAcc* const acc = thread_acc_[k].data();
+  const Vec2 *const xs = particles_.x.data(), *const vs = particles_.v.data();
+  const Vec2* const displacements = particles_.displacement.data();
+  const double *const half_sizes = particles_.half_size.data(), *const masses = particles_.mass.data();
+  const double* const volumes = particles_.volume.data();
+  const Voigt* const stresses = particles_.stress.data();
+  std::uint16_t* const stencil_fields = stencil_fields_.data();
   for (std::size_t p = begin; p < end; ++p) {
-    const Vec2 x = particles_.x[p];
+    const Vec2 x = xs[p];
     const Vec2 rel = x - g.origin;
-    const double lp = particles_.half_size[p];
-    const StencilScale scale(g.h, lp);
+    const StencilScale scale(g.h, half_sizes[p]);
     const auto sx = ugimp_stencil(rel.x(), scale);
     const auto sy = ugimp_stencil(rel.y(), scale);
-    const double m = particles_.mass[p];
-    const Vec2 mv = m * particles_.v[p];
-    const Voigt& s = particles_.stress[p];
+    const double m = masses[p];
+    const Vec2 mv = m * vs[p];
+    const Voigt& s = stresses[p];
     // sigma . grad S = c0 gx + c1 gy with the stress's columns (s = xx, yy, xy, zz)
     const Vec2 c0(s[0], s[2]), c1(s[2], s[1]);
-    const double vol = particles_.volume[p];
+    const double vol = volumes[p];
     bool near = false;
     std::uint16_t sides = 0;
     Vec2 mu = Vec2::Zero();
     if constexpr (kCracks) {
       near = near_crack(x);
       if (near) sides = 1u << 15;
-      mu = m * particles_.displacement[p];
+      mu = m * displacements[p];
     }
     for_stencil(g, sx, sy, [&](int b, int a, std::size_t n, double w, double gx, double gy) {
       std::size_t slot = n * F;
@@ -147,7 +155,7 @@ void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
       f.f -= vol * (gx * c0 + gy * c1);  // internal force -V sigma . grad S
       if constexpr (kCracks) f.u += w * mu;
     });
-    if constexpr (kCracks) stencil_fields_[p] = sides;
+    if constexpr (kCracks) stencil_fields[p] = sides;
   }
 }
 
@@ -201,9 +209,20 @@ void Solver::p2g_reduce(std::size_t k) {
   }
 }
 
+// The grid and the arrays through locals, as in p2g_scatter.
 template <bool kCracks>
 void Solver::g2p(double dt) {
-  const auto& g = config_.grid;
+  const Grid g = config_.grid;
+  const Vec2* const velocity[2] = {velocity_[0].data(), velocity_[1].data()};
+  const Vec2* const acceleration[2] = {acceleration_[0].data(), acceleration_[1].data()};
+  const std::uint16_t* const stencil_fields = stencil_fields_.data();
+  Vec2 *const xs = particles_.x.data(), *const vs = particles_.v.data();
+  Vec2* const displacements = particles_.displacement.data();
+  Eigen::Matrix2d* const grad_us = particles_.grad_u.data();
+  Voigt* const stresses = particles_.stress.data();
+  const double* const half_sizes = particles_.half_size.data();
+  const std::int32_t* const materials = particles_.material.data();
+  const double *const lambdas = lambda_.data(), *const shears = shear_.data();
   const double pic = config_.damping.pic_fraction;
   const Vec2 lo = g.origin, hi = g.origin + g.h * Vec2(g.nx, g.ny);
   const auto count = static_cast<std::int64_t>(particles_.size());
@@ -212,30 +231,29 @@ void Solver::g2p(double dt) {
 #pragma omp parallel for num_threads(static_cast <int>(thread_acc_.size())) schedule(static)
   for (std::int64_t q = 0; q < count; ++q) {
     const auto p = static_cast<std::size_t>(q);
-    const Vec2 rel = particles_.x[p] - g.origin;
-    const double lp = particles_.half_size[p];
-    const StencilScale scale(g.h, lp);
+    const Vec2 rel = xs[p] - g.origin;
+    const StencilScale scale(g.h, half_sizes[p]);
     const auto sx = ugimp_stencil(rel.x(), scale);
     const auto sy = ugimp_stencil(rel.y(), scale);
     std::uint16_t sides = 0;
-    if constexpr (kCracks) sides = stencil_fields_[p];  // the fields P2G found for its nodes
+    if constexpr (kCracks) sides = stencil_fields[p];  // the fields P2G found for its nodes
     Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
     // The velocity gradient L = grad v by columns: (L00, L10) and (L01, L11).
     Vec2 l_x = Vec2::Zero(), l_y = Vec2::Zero();
     for_stencil(g, sx, sy, [&](int b, int c, std::size_t n, double w, double gx, double gy) {
       const int field = (sides >> (3 * b + c)) & 1;
-      const Vec2& vn = velocity_[field][n];
+      const Vec2& vn = velocity[field][n];
       v_new += w * vn;
-      a += w * acceleration_[field][n];
+      a += w * acceleration[field][n];
       l_x += gx * vn;
       l_y += gy * vn;
     });
     const double l00 = l_x.x(), l01 = l_y.x(), l10 = l_x.y(), l11 = l_y.y();
-    particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
-    particles_.x[p] += dt * v_new;
+    vs[p] = (1 - pic) * (vs[p] + dt * a) + pic * v_new;
+    xs[p] += dt * v_new;
     if constexpr (kCracks) {
-      particles_.displacement[p] += dt * v_new;
-      auto& gu = particles_.grad_u[p];
+      displacements[p] += dt * v_new;
+      auto& gu = grad_us[p];
       gu(0, 0) += dt * l00;
       gu(0, 1) += dt * l01;
       gu(1, 0) += dt * l10;
@@ -243,11 +261,11 @@ void Solver::g2p(double dt) {
     }
     // Small-strain elastic update, plane strain (eps_zz = 0).
     const double dxx = l00 * dt, dyy = l11 * dt, dxy = 0.5 * (l01 + l10) * dt;
-    const auto m = static_cast<std::size_t>(particles_.material[p]);
-    const double lam = lambda_[m], mu = shear_[m];
+    const auto m = static_cast<std::size_t>(materials[p]);
+    const double lam = lambdas[m], mu = shears[m];
     const double tr = dxx + dyy;
-    particles_.stress[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
-    const Vec2& x = particles_.x[p];
+    stresses[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
+    const Vec2& x = xs[p];
     // A particle that leaves the grid, becomes NaN, or moves more than a
     // cell in one step (|v| > 2 c_p at the largest valid CFL factor; the
     // shape functions cannot follow that) has run away.
