@@ -3,8 +3,9 @@
 // piecewise definition, and the linear (classic MPM) limit lp -> 0.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -100,7 +101,7 @@ TEST(Ugimp, FasterStencilGivesTheSameBits) {
       for (int step = 0; step < 9; ++step, x = std::nextafter(x, 1e9)) positions.push_back(x);
     }
   }
-  auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  auto same = [](double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); };
   for (double lp : {h / 2, h / 4, h / 6, h / 8, frac(rng) * h}) {
     const StencilScale scale(h, lp);
     for (double x : positions) {
