@@ -119,6 +119,7 @@ void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
   const double* const volumes = particles_.volume.data();
   const Voigt* const stresses = particles_.stress.data();
   std::uint16_t* const stencil_fields = stencil_fields_.data();
+  std::size_t side_first = std::numeric_limits<std::size_t>::max(), side_last = 0;  // field 1's nodes
   for (std::size_t p = begin; p < end; ++p) {
     const Vec2 x = xs[p];
     const Vec2 rel = x - g.origin;
@@ -145,6 +146,8 @@ void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
         if (near && w != 0 && field_of(x, g.position(static_cast<int>(n)))) {
           ++slot;
           sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
+          side_first = std::min(side_first, n);
+          side_last = std::max(side_last, n + 1);
         }
       }
       // Both components of each vector in one SSE2 operation (the same
@@ -157,11 +160,14 @@ void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
     });
     if constexpr (kCracks) stencil_fields[p] = sides;
   }
+  thread_side_span_[k] = {std::min(side_first, side_last), side_last};
 }
 
 // Thread k's slice of the nodes, summed over every thread's band, into the
 // fields (one field, or two with cracks), and the nodes it touched; the
-// entries summed are zeroed for the next P2G.
+// entries summed are zeroed for the next P2G. Field 1 is summed only over
+// the nodes where the thread's particles gave it anything (a few rows along
+// the cracks): elsewhere its entries hold +0, and adding +0 changes no sum.
 template <bool kCracks>
 void Solver::p2g_reduce(std::size_t k) {
   constexpr std::size_t F = kCracks ? 2 : 1;
@@ -184,7 +190,9 @@ void Solver::p2g_reduce(std::size_t k) {
       for (std::size_t t = 0; t < threads; ++t) {
         const auto& sp = thread_span_[t];
         if (u < sp[0] || u >= sp[1]) continue;
-        for (std::size_t f = 0; f < F; ++f) {
+        const auto& side = thread_side_span_[t];
+        const std::size_t fields = u >= side[0] && u < side[1] ? F : 1;
+        for (std::size_t f = 0; f < fields; ++f) {
           NodeAcc& from = thread_acc_[t][u * F + f];
           sum[f].m += from.m;
           sum[f].p += from.p;

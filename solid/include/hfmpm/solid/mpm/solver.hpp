@@ -229,7 +229,8 @@ class Solver {
     double m = 0;           // mass
   };
   std::vector<std::vector<NodeAcc>> thread_acc_;
-  std::vector<std::array<std::size_t, 2>> thread_span_;  // [first, last) node
+  std::vector<std::array<std::size_t, 2>> thread_span_;       // [first, last) node
+  std::vector<std::array<std::size_t, 2>> thread_side_span_;  // [first, last) node with field-1 entries
   std::vector<std::vector<int>> thread_active_;
   // Per particle, cracks only, set by P2G for G2P: bit 15 = near a crack,
   // bit 3 b + a = node (a, b) of its 3 x 3 stencil is in field 1.
