@@ -2,10 +2,14 @@
 // with 1 and 2 threads, and memory per particle, for an uncracked block under
 // a confining stress with one loaded edge (so every step does real work).
 //
-//   build/release/bin/hfmpm-bench-solid [--cells N] [--steps S] [--uncracked-only]
+//   build/release/bin/hfmpm-bench-solid [--cells N] [--steps S] [--threads T] [--ppc P] [--uncracked-only]
+//                                       [--no-roofline]
 //
 // --cells: the block's cells per side (default 200: 160,000 particles at 2 x 2
-// per cell); --uncracked-only skips the cracked case (its size is fixed).
+// per cell); --threads: only T threads (default: 1, then 2); --ppc: particles
+// per cell and direction of the uncracked block (default 2; the coupled KGD
+// scenes have 1 in most of the body); --uncracked-only skips the cracked case
+// (its size is fixed); --no-roofline skips the bandwidth estimate.
 //
 // Then a roofline estimate: the machine's memory bandwidth (a STREAM-style
 // triad a = b + s c over 3 x 64 MB, 1 and 2 threads, best of 5), the bytes
@@ -27,8 +31,9 @@ using namespace hfmpm::solid::mpm;
 using hfmpm::TimeFunction;
 using hfmpm::Vec2;
 
-SolidConfig block(int cells, int threads) {
+SolidConfig block(int cells, int threads, int ppc) {
   SolidConfig c;
+  c.particles_per_cell = ppc;
   const double h = 1.0 / cells;
   c.grid.origin = Vec2(-2 * h, -2 * h);
   c.grid.h = h;
@@ -50,7 +55,7 @@ SolidConfig block(int cells, int threads) {
 
 // Sneddon's set-up (bench only): half box 5a x 10a, crack from the symmetry
 // plane to x = a with uniform face pressure, h = a / cells_per_a.
-SolidConfig cracked(int cells_per_a, int threads) {
+SolidConfig cracked(int cells_per_a, int threads, int /*ppc: the default*/) {
   SolidConfig c;
   const double h = 1.0 / cells_per_a;
   c.grid.origin = Vec2(0, -5 - 2 * h);
@@ -127,10 +132,10 @@ struct Measured {
 };
 
 template <class Make>
-Measured run(const char* name, Make make, int size, int steps) {
+Measured run(const char* name, Make make, int size, int ppc, int steps, const std::vector<int>& thread_counts) {
   Measured out;
-  for (int threads : {1, 2}) {
-    Solver solid(make(size, threads));
+  for (int threads : thread_counts) {
+    Solver solid(make(size, threads, ppc));
     if (!solid.cracks().empty()) solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), 1e6));
     const double dt = solid.stable_dt();
     solid.step(dt);  // warm up: first touch of the grid
@@ -150,29 +155,43 @@ Measured run(const char* name, Make make, int size, int steps) {
 
 int main(int argc, char** argv) {
   int cells = 200, steps = 200;
-  bool cracked_case = true;
+  int ppc = 2;
+  bool cracked_case = true, roofline = true;
+  std::vector<int> thread_counts{1, 2};
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--cells" && i + 1 < argc) {
       cells = std::atoi(argv[++i]);
     } else if (arg == "--steps" && i + 1 < argc) {
       steps = std::atoi(argv[++i]);
+    } else if (arg == "--threads" && i + 1 < argc) {
+      thread_counts = {std::max(1, std::atoi(argv[++i]))};
+    } else if (arg == "--ppc" && i + 1 < argc) {
+      ppc = std::atoi(argv[++i]);
+    } else if (arg == "--no-roofline") {
+      roofline = false;
     } else if (arg == "--uncracked-only") {
       cracked_case = false;
     } else {
-      std::fprintf(stderr, "usage: %s [--cells N] [--steps S] [--uncracked-only]\n", argv[0]);
+      std::fprintf(stderr,
+                   "usage: %s [--cells N] [--steps S] [--threads T] [--ppc P] [--uncracked-only] [--no-roofline]\n",
+                   argv[0]);
       return 2;
     }
   }
-  if (cells < 2 || cells > 4000 || steps < 1) {
-    std::fprintf(stderr, "--cells must be in [2, 4000] and --steps >= 1 (got %d, %d)\n", cells, steps);
+  if (cells < 2 || cells > 4000 || steps < 1 || ppc < 1 || ppc > 4) {
+    std::fprintf(stderr, "--cells must be in [2, 4000], --steps >= 1 and --ppc in [1, 4] (got %d, %d, %d)\n", cells,
+                 steps, ppc);
     return 2;
   }
   std::printf(
       "| case | particles | threads | steps | wall (s) | particle-steps/s | bytes/particle |\n"
       "|---|---|---|---|---|---|---|\n");
-  std::vector<std::pair<std::string, Measured>> cases{{"uncracked block", run("uncracked block", block, cells, steps)}};
-  if (cracked_case) cases.emplace_back("Sneddon, cracked", run("Sneddon, cracked (h = a/20)", cracked, 20, steps));
+  std::vector<std::pair<std::string, Measured>> cases{
+      {"uncracked block", run("uncracked block", block, cells, ppc, steps, thread_counts)}};
+  if (cracked_case)
+    cases.emplace_back("Sneddon, cracked", run("Sneddon, cracked (h = a/20)", cracked, 20, 2, steps, thread_counts));
+  if (!roofline) return 0;
   const double bw1 = triad_bandwidth(1), bw2 = triad_bandwidth(2);
   std::printf("\nmemory bandwidth (triad, best of 5): %.1f GB/s on 1 thread, %.1f GB/s on 2\n", bw1, bw2);
   std::printf(

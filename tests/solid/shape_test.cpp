@@ -3,7 +3,11 @@
 // piecewise definition, and the linear (classic MPM) limit lp -> 0.
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <cstdint>
 #include <random>
+#include <vector>
 
 #include "hfmpm/solid/mpm/crack.hpp"
 #include "hfmpm/solid/mpm/shape.hpp"
@@ -49,6 +53,66 @@ TEST(Ugimp, TendsToLinearForSmallParticles) {
   for (double d : {-0.9, -0.3, 0.2, 0.7}) {
     EXPECT_NEAR(ugimp_1d(d, h, 1e-7).s, linear_1d(d, h).s, 1e-6);
     EXPECT_NEAR(ugimp_1d(d, h, 1e-7).g, linear_1d(d, h).g, 1e-6);
+  }
+}
+
+// ugimp_stencil before issue 20 (std::floor, the divisions per call): the
+// reference the faster one must match bit for bit.
+Stencil1D reference_stencil(double x, double h, double lp) {
+  Stencil1D st;
+  const double inv_h = 1 / h, inv_hlp = 1 / (h * lp);
+  st.first = static_cast<int>(std::floor(x * inv_h + 0.5)) - 1;
+  for (int k = 0; k < 3; ++k) {
+    const double d = x - (st.first + k) * h;
+    const double a = std::abs(d);
+    const double sign = d < 0 ? -1.0 : 1.0;
+    double s = 0, g = 0;
+    if (a < lp) {
+      s = 1 - 0.5 * (d * d + lp * lp) * inv_hlp;
+      g = -d * inv_hlp;
+    } else if (a <= h - lp) {
+      s = 1 - a * inv_h;
+      g = -sign * inv_h;
+    } else if (a < h + lp) {
+      const double r = h + lp - a;
+      s = 0.25 * r * r * inv_hlp;
+      g = -0.5 * sign * r * inv_hlp;
+    }
+    st.s[static_cast<std::size_t>(k)] = s;
+    st.g[static_cast<std::size_t>(k)] = g;
+  }
+  return st;
+}
+
+// The stencil's floor by truncation and the reciprocals shared by both
+// directions give the same bits as before, also at the ends of the pieces
+// (|d| = lp, h - lp, h + lp to within a few ulps: one particle per cell puts
+// every particle there), on nodes, and left of the origin.
+TEST(Ugimp, FasterStencilGivesTheSameBits) {
+  const double h = 0.04;
+  std::vector<double> positions;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> pos(-2 * h, 200 * h), frac(0.01, 0.5);
+  for (int k = 0; k < 20000; ++k) positions.push_back(pos(rng));
+  for (int cell = -2; cell < 50; ++cell) {
+    for (double offset : {0.0, 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875}) {
+      double x = (cell + offset) * h;
+      for (int step = 0; step < 4; ++step) x = std::nextafter(x, -1e9);
+      for (int step = 0; step < 9; ++step, x = std::nextafter(x, 1e9)) positions.push_back(x);
+    }
+  }
+  auto same = [](double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); };
+  for (double lp : {h / 2, h / 4, h / 6, h / 8, frac(rng) * h}) {
+    const StencilScale scale(h, lp);
+    for (double x : positions) {
+      const Stencil1D st = ugimp_stencil(x, scale), ref = reference_stencil(x, h, lp);
+      ASSERT_EQ(st.first, ref.first) << "x = " << x << ", lp = " << lp;
+      for (std::size_t a = 0; a < 3; ++a) {
+        ASSERT_TRUE(same(st.s[a], ref.s[a]) && same(st.g[a], ref.g[a]))
+            << "x = " << x << ", lp = " << lp << ", node " << a << ": " << st.s[a] << " " << ref.s[a] << ", " << st.g[a]
+            << " " << ref.g[a];
+      }
+    }
   }
 }
 

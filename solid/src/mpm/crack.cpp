@@ -103,11 +103,6 @@ void Crack::prepare(double extension, double tip_tolerance) {
   }
 }
 
-bool Crack::near(const Vec2& p, double margin) const {
-  return p.x() >= lo_.x() - margin && p.x() <= hi_.x() + margin && p.y() >= lo_.y() - margin &&
-         p.y() <= hi_.y() + margin;
-}
-
 bool Crack::crosses(const Vec2& p, const Vec2& q) const {
   const Vec2 lo = p.cwiseMin(q), hi = p.cwiseMax(q);
   bool odd = false;

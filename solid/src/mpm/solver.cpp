@@ -54,6 +54,7 @@ Solver::Solver(SolidConfig config) : config_(std::move(config)) {
   const auto threads = static_cast<std::size_t>(std::max(1, config_.threads));
   thread_acc_.resize(threads);
   thread_span_.assign(threads, {0, 0});
+  thread_side_span_.assign(threads, {0, 0});
   thread_active_.resize(threads);
   for (auto& acc : thread_acc_) acc.resize(n * static_cast<std::size_t>(fields));
   if (cracked) field1_.resize(n);

@@ -36,15 +36,6 @@ CellWeights cell_weights(const Grid& g, const Vec2& x) {
 
 }  // namespace
 
-bool Solver::near_crack(const Vec2& x) const {
-  // A particle-node segment is at most about 2.2 h long (uGIMP reach).
-  const double margin = 2.5 * config_.grid.h;
-  for (const auto& crack : cracks_) {
-    if (crack.near(x, margin)) return true;
-  }
-  return false;
-}
-
 int Solver::field_of(const Vec2& from, const Vec2& node) const {
   bool odd = false;
   for (const auto& crack : cracks_) {

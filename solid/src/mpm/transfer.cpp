@@ -16,20 +16,18 @@
 namespace hfmpm::solid::mpm {
 namespace {
 
-// The one stencil loop of P2G and G2P: fn(b, a, n, w, gx, gy) for each of the
-// up to 3 x 3 nodes n = (sx.first + a, sy.first + b) on the grid where the
-// particle's weight w is nonzero, with the weight's gradient (gx, gy).
-template <class Fn>
-inline void for_stencil(const Grid& g, const Stencil1D& sx, const Stencil1D& sy, Fn&& fn) {
+// The nodes of a particle's 3 x 3 stencil, clipped to the grid if kClip.
+template <bool kClip, bool kSkipZero, class Fn>
+inline void stencil_nodes(const Grid& g, const Stencil1D& sx, const Stencil1D& sy, Fn&& fn) {
   for (int b = 0; b < 3; ++b) {
     const int j = sy.first + b;
-    if (j < 0 || j > g.ny) continue;
+    if (kClip && (j < 0 || j > g.ny)) continue;
     const double syb = sy.s[static_cast<std::size_t>(b)], gyb = sy.g[static_cast<std::size_t>(b)];
     for (int a = 0; a < 3; ++a) {
       const int i = sx.first + a;
-      if (i < 0 || i > g.nx) continue;
+      if (kClip && (i < 0 || i > g.nx)) continue;
       const double w = sx.s[static_cast<std::size_t>(a)] * syb;
-      if (w == 0) continue;
+      if (kSkipZero && w == 0) continue;
       const double gx = sx.g[static_cast<std::size_t>(a)] * syb;
       const double gy = sx.s[static_cast<std::size_t>(a)] * gyb;
       fn(b, a, static_cast<std::size_t>(g.node(i, j)), w, gx, gy);
@@ -37,11 +35,33 @@ inline void for_stencil(const Grid& g, const Stencil1D& sx, const Stencil1D& sy,
   }
 }
 
+// The one stencil loop of P2G and G2P: fn(b, a, n, w, gx, gy) for each of the
+// 3 x 3 nodes n = (sx.first + a, sy.first + b) on the grid, with the
+// particle's weight w there and its gradient (gx, gy). Without kSkipZero,
+// nodes the particle does not reach come too, with w = gx = gy = 0: a weight
+// of zero adds an exact zero (the sums stay bit for bit what they would be
+// without it), and testing for it cost more than it saved in the uncracked
+// step (particles a round-off off a piece's end make it a coin toss for the
+// branch predictor: half the mispredicted branches of the step). With cracks
+// (kSkipZero) a node costs more (the side test, the displacement sum, the
+// field lookup), and skipping the zeros saves a fifth of the instructions.
+// Only particles near the grid's edge need the clipping.
+template <bool kSkipZero = false, class Fn>
+inline void for_stencil(const Grid& g, const Stencil1D& sx, const Stencil1D& sy, Fn&& fn) {
+  if (sx.first >= 0 && sx.first + 2 <= g.nx && sy.first >= 0 && sy.first + 2 <= g.ny) {
+    stencil_nodes<false, kSkipZero>(g, sx, sy, fn);
+  } else {
+    stencil_nodes<true, kSkipZero>(g, sx, sy, fn);
+  }
+}
+
 }  // namespace
 
-// P2G: each thread zeroes the band of grid rows its particles reach in its
-// own accumulator, scatters its particles into it, and (after all have)
-// reduces one slice of the nodes over every thread's band into the fields.
+// P2G: each thread finds the band of grid rows its particles reach, scatters
+// its particles into its own accumulator there, and (after all have) reduces
+// one slice of the nodes over every thread's band into the fields, zeroing
+// the accumulators' entries as it reads them: between P2Gs they are all
+// zero (one pass over the bands per step instead of two).
 template <bool kCracks>
 void Solver::p2g() {
   const auto threads = thread_acc_.size();
@@ -54,7 +74,7 @@ void Solver::p2g() {
     const auto k = static_cast<std::size_t>(omp_get_thread_num());
     const std::size_t begin = count * k / threads;
     const std::size_t end = count * (k + 1) / threads;
-    thread_span_[k] = p2g_zero_band<kCracks>(k, begin, end);
+    thread_span_[k] = p2g_band(begin, end);
     p2g_scatter<kCracks>(k, begin, end);
 #pragma omp barrier
     p2g_reduce<kCracks>(k);
@@ -64,14 +84,11 @@ void Solver::p2g() {
 }
 
 // The rows of nodes particles [begin, end) reach (particles are stored row
-// by row, so each thread's span is a band of the grid), zeroed in thread k's
-// accumulator; returns the band as node indices [first, last).
-template <bool kCracks>
-std::array<std::size_t, 2> Solver::p2g_zero_band(std::size_t k, std::size_t begin, std::size_t end) {
+// by row, so each thread's span is a band of the grid), as node indices
+// [first, last).
+std::array<std::size_t, 2> Solver::p2g_band(std::size_t begin, std::size_t end) const {
   const auto& g = config_.grid;
-  constexpr std::size_t F = kCracks ? 2 : 1;  // fields per node in the accumulators
   const std::size_t row = static_cast<std::size_t>(g.nodes_x());
-  auto& acc = thread_acc_[k];
   double y_lo = std::numeric_limits<double>::infinity(), y_hi = -y_lo;
   for (std::size_t p = begin; p < end; ++p) {
     y_lo = std::min(y_lo, particles_.x[p].y());
@@ -84,8 +101,6 @@ std::array<std::size_t, 2> Solver::p2g_zero_band(std::size_t k, std::size_t begi
     const int j0 = std::clamp(row_of(y_lo) - 2, 0, g.ny);
     const int j1 = std::clamp(row_of(y_hi) + 2, 0, g.ny);
     span = {static_cast<std::size_t>(j0) * row, static_cast<std::size_t>(j1 + 1) * row};
-    std::fill(acc.begin() + static_cast<std::ptrdiff_t>(span[0] * F),
-              acc.begin() + static_cast<std::ptrdiff_t>(span[1] * F), NodeAcc{});
   }
   return span;
 }
@@ -93,55 +108,69 @@ std::array<std::size_t, 2> Solver::p2g_zero_band(std::size_t k, std::size_t begi
 // Mass, momentum, internal force (and, with cracks, the mass-weighted
 // displacement and each particle's side of the crack per node) of particles
 // [begin, end) into thread k's accumulator.
+//
+// The grid and the arrays are read through locals: the SSE2 stores may
+// alias anything, so members would be reloaded at every node.
 template <bool kCracks>
 void Solver::p2g_scatter(std::size_t k, std::size_t begin, std::size_t end) {
-  const auto& g = config_.grid;
+  const Grid g = config_.grid;
   constexpr std::size_t F = kCracks ? 2 : 1;
-  auto& acc = thread_acc_[k];
+  NodeAcc* const acc = thread_acc_[k].data();
+  const Vec2 *const xs = particles_.x.data(), *const vs = particles_.v.data();
+  const Vec2* const displacements = particles_.displacement.data();
+  const double *const half_sizes = particles_.half_size.data(), *const masses = particles_.mass.data();
+  const double* const volumes = particles_.volume.data();
+  const Voigt* const stresses = particles_.stress.data();
+  std::uint16_t* const stencil_fields = stencil_fields_.data();
+  std::size_t side_first = std::numeric_limits<std::size_t>::max(), side_last = 0;  // field 1's nodes
   for (std::size_t p = begin; p < end; ++p) {
-    const Vec2 x = particles_.x[p];
+    const Vec2 x = xs[p];
     const Vec2 rel = x - g.origin;
-    const double lp = particles_.half_size[p];
-    const auto sx = ugimp_stencil(rel.x(), g.h, lp);
-    const auto sy = ugimp_stencil(rel.y(), g.h, lp);
-    const double m = particles_.mass[p];
-    const Vec2 mv = m * particles_.v[p];
-    const Voigt& s = particles_.stress[p];
-    const double vol = particles_.volume[p];
+    const StencilScale scale(g.h, half_sizes[p]);
+    const auto sx = ugimp_stencil(rel.x(), scale);
+    const auto sy = ugimp_stencil(rel.y(), scale);
+    const double m = masses[p];
+    const Vec2 mv = m * vs[p];
+    const Voigt& s = stresses[p];
+    // sigma . grad S = c0 gx + c1 gy with the stress's columns (s = xx, yy, xy, zz)
+    const Vec2 c0(s[0], s[2]), c1(s[2], s[1]);
+    const double vol = volumes[p];
     bool near = false;
     std::uint16_t sides = 0;
     Vec2 mu = Vec2::Zero();
     if constexpr (kCracks) {
       near = near_crack(x);
       if (near) sides = 1u << 15;
-      mu = m * particles_.displacement[p];
+      mu = m * displacements[p];
     }
-    for_stencil(g, sx, sy, [&](int b, int a, std::size_t n, double w, double gx, double gy) {
+    for_stencil<kCracks>(g, sx, sy, [&](int b, int a, std::size_t n, double w, double gx, double gy) {
       std::size_t slot = n * F;
       if constexpr (kCracks) {
         if (near && field_of(x, g.position(static_cast<int>(n)))) {
           ++slot;
           sides = static_cast<std::uint16_t>(sides | (1u << (3 * b + a)));
+          side_first = std::min(side_first, n);
+          side_last = std::max(side_last, n + 1);
         }
       }
+      // Both components of each vector in one SSE2 operation (the same
+      // products and sums as component by component).
       NodeAcc& f = acc[slot];
       f.m += w * m;
-      f.px += w * mv.x();
-      f.py += w * mv.y();
-      // internal force -V sigma . grad S (s = xx, yy, xy, zz)
-      f.fx -= vol * (s[0] * gx + s[2] * gy);
-      f.fy -= vol * (s[2] * gx + s[1] * gy);
-      if constexpr (kCracks) {
-        f.ux += w * mu.x();
-        f.uy += w * mu.y();
-      }
+      f.p += w * mv;
+      f.f -= vol * (gx * c0 + gy * c1);  // internal force -V sigma . grad S
+      if constexpr (kCracks) f.u += w * mu;
     });
-    if constexpr (kCracks) stencil_fields_[p] = sides;
+    if constexpr (kCracks) stencil_fields[p] = sides;
   }
+  thread_side_span_[k] = {std::min(side_first, side_last), side_last};
 }
 
 // Thread k's slice of the nodes, summed over every thread's band, into the
-// fields (one field, or two with cracks), and the nodes it touched.
+// fields (one field, or two with cracks), and the nodes it touched; the
+// entries summed are zeroed for the next P2G. Field 1 is summed only over
+// the nodes where the thread's particles gave it anything (a few rows along
+// the cracks): elsewhere its entries hold +0, and adding +0 changes no sum.
 template <bool kCracks>
 void Solver::p2g_reduce(std::size_t k) {
   constexpr std::size_t F = kCracks ? 2 : 1;
@@ -164,15 +193,15 @@ void Solver::p2g_reduce(std::size_t k) {
       for (std::size_t t = 0; t < threads; ++t) {
         const auto& sp = thread_span_[t];
         if (u < sp[0] || u >= sp[1]) continue;
-        for (std::size_t f = 0; f < F; ++f) {
-          const NodeAcc& from = thread_acc_[t][u * F + f];
+        const auto& side = thread_side_span_[t];
+        const std::size_t fields = u >= side[0] && u < side[1] ? F : 1;
+        for (std::size_t f = 0; f < fields; ++f) {
+          NodeAcc& from = thread_acc_[t][u * F + f];
           sum[f].m += from.m;
-          sum[f].px += from.px;
-          sum[f].py += from.py;
-          sum[f].fx += from.fx;
-          sum[f].fy += from.fy;
-          sum[f].ux += from.ux;
-          sum[f].uy += from.uy;
+          sum[f].p += from.p;
+          sum[f].f += from.f;
+          sum[f].u += from.u;
+          from = NodeAcc{};
         }
       }
       bool touched = sum[0].m > 0;
@@ -183,17 +212,28 @@ void Solver::p2g_reduce(std::size_t k) {
       for (std::size_t f = 0; f < F; ++f) {
         NodalFields& to = f ? field1_ : field0_;
         to.mass[u] = sum[f].m;
-        to.momentum[u] = Vec2(sum[f].px, sum[f].py);
-        to.force[u] = Vec2(sum[f].fx, sum[f].fy);
-        if constexpr (kCracks) to.displaced[u] = Vec2(sum[f].ux, sum[f].uy);
+        to.momentum[u] = sum[f].p;
+        to.force[u] = sum[f].f;
+        if constexpr (kCracks) to.displaced[u] = sum[f].u;
       }
     }
   }
 }
 
+// The grid and the arrays through locals, as in p2g_scatter.
 template <bool kCracks>
 void Solver::g2p(double dt) {
-  const auto& g = config_.grid;
+  const Grid g = config_.grid;
+  const Vec2* const velocity[2] = {velocity_[0].data(), velocity_[1].data()};
+  const Vec2* const acceleration[2] = {acceleration_[0].data(), acceleration_[1].data()};
+  const std::uint16_t* const stencil_fields = stencil_fields_.data();
+  Vec2 *const xs = particles_.x.data(), *const vs = particles_.v.data();
+  Vec2* const displacements = particles_.displacement.data();
+  Eigen::Matrix2d* const grad_us = particles_.grad_u.data();
+  Voigt* const stresses = particles_.stress.data();
+  const double* const half_sizes = particles_.half_size.data();
+  const std::int32_t* const materials = particles_.material.data();
+  const double *const lambdas = lambda_.data(), *const shears = shear_.data();
   const double pic = config_.damping.pic_fraction;
   const Vec2 lo = g.origin, hi = g.origin + g.h * Vec2(g.nx, g.ny);
   const auto count = static_cast<std::int64_t>(particles_.size());
@@ -202,29 +242,29 @@ void Solver::g2p(double dt) {
 #pragma omp parallel for num_threads(static_cast <int>(thread_acc_.size())) schedule(static)
   for (std::int64_t q = 0; q < count; ++q) {
     const auto p = static_cast<std::size_t>(q);
-    const Vec2 rel = particles_.x[p] - g.origin;
-    const double lp = particles_.half_size[p];
-    const auto sx = ugimp_stencil(rel.x(), g.h, lp);
-    const auto sy = ugimp_stencil(rel.y(), g.h, lp);
+    const Vec2 rel = xs[p] - g.origin;
+    const StencilScale scale(g.h, half_sizes[p]);
+    const auto sx = ugimp_stencil(rel.x(), scale);
+    const auto sy = ugimp_stencil(rel.y(), scale);
     std::uint16_t sides = 0;
-    if constexpr (kCracks) sides = stencil_fields_[p];  // the fields P2G found for its nodes
+    if constexpr (kCracks) sides = stencil_fields[p];  // the fields P2G found for its nodes
     Vec2 v_new = Vec2::Zero(), a = Vec2::Zero();
-    double l00 = 0, l01 = 0, l10 = 0, l11 = 0;  // velocity gradient L = grad v
-    for_stencil(g, sx, sy, [&](int b, int c, std::size_t n, double w, double gx, double gy) {
+    // The velocity gradient L = grad v by columns: (L00, L10) and (L01, L11).
+    Vec2 l_x = Vec2::Zero(), l_y = Vec2::Zero();
+    for_stencil<kCracks>(g, sx, sy, [&](int b, int c, std::size_t n, double w, double gx, double gy) {
       const int field = (sides >> (3 * b + c)) & 1;
-      const Vec2& vn = velocity_[field][n];
+      const Vec2& vn = velocity[field][n];
       v_new += w * vn;
-      a += w * acceleration_[field][n];
-      l00 += vn.x() * gx;
-      l01 += vn.x() * gy;
-      l10 += vn.y() * gx;
-      l11 += vn.y() * gy;
+      a += w * acceleration[field][n];
+      l_x += gx * vn;
+      l_y += gy * vn;
     });
-    particles_.v[p] = (1 - pic) * (particles_.v[p] + dt * a) + pic * v_new;
-    particles_.x[p] += dt * v_new;
+    const double l00 = l_x.x(), l01 = l_y.x(), l10 = l_x.y(), l11 = l_y.y();
+    vs[p] = (1 - pic) * (vs[p] + dt * a) + pic * v_new;
+    xs[p] += dt * v_new;
     if constexpr (kCracks) {
-      particles_.displacement[p] += dt * v_new;
-      auto& gu = particles_.grad_u[p];
+      displacements[p] += dt * v_new;
+      auto& gu = grad_us[p];
       gu(0, 0) += dt * l00;
       gu(0, 1) += dt * l01;
       gu(1, 0) += dt * l10;
@@ -232,11 +272,11 @@ void Solver::g2p(double dt) {
     }
     // Small-strain elastic update, plane strain (eps_zz = 0).
     const double dxx = l00 * dt, dyy = l11 * dt, dxy = 0.5 * (l01 + l10) * dt;
-    const auto m = static_cast<std::size_t>(particles_.material[p]);
-    const double lam = lambda_[m], mu = shear_[m];
+    const auto m = static_cast<std::size_t>(materials[p]);
+    const double lam = lambdas[m], mu = shears[m];
     const double tr = dxx + dyy;
-    particles_.stress[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
-    const Vec2& x = particles_.x[p];
+    stresses[p] += Voigt(lam * tr + 2 * mu * dxx, lam * tr + 2 * mu * dyy, 2 * mu * dxy, lam * tr);
+    const Vec2& x = xs[p];
     // A particle that leaves the grid, becomes NaN, or moves more than a
     // cell in one step (|v| > 2 c_p at the largest valid CFL factor; the
     // shape functions cannot follow that) has run away.

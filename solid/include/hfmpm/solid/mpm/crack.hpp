@@ -65,7 +65,11 @@ class Crack {
   // Parity of crossings of the segment p-q with the crack (extended at mouths).
   bool crosses(const Vec2& p, const Vec2& q) const;
   // Axis-aligned box around the crack (with extensions), grown by `margin`.
-  bool near(const Vec2& p, double margin) const;
+  // (Inline: P2G asks it for every particle.)
+  bool near(const Vec2& p, double margin) const {
+    return p.x() >= lo_.x() - margin && p.x() <= hi_.x() + margin && p.y() >= lo_.y() - margin &&
+           p.y() <= hi_.y() + margin;
+  }
 
   // Crack plane = midpoint of the surfaces (after the surfaces moved).
   void update_plane();

@@ -44,15 +44,28 @@ struct Stencil1D {
   std::array<double, 3> g{};
 };
 
-// x: particle coordinate relative to the grid origin, h: cell size, lp: half-width.
-// The same weights as ugimp_1d at the 3 nodes, with two divisions instead of
-// a dozen (this runs twice per particle and step).
-inline Stencil1D ugimp_stencil(double x, double h, double lp) {
+// The constants of a particle's stencils: cell size, half-width and their
+// reciprocals, computed once for both directions.
+struct StencilScale {
+  double h, lp, inv_h, inv_hlp;
+  StencilScale(double cell, double half_width)
+      : h(cell), lp(half_width), inv_h(1 / cell), inv_hlp(1 / (cell * half_width)) {}
+};
+
+// x: particle coordinate relative to the grid origin. The same weights as
+// ugimp_1d at the 3 nodes, with the two divisions in `scale` (this runs for
+// both directions of every particle twice per step).
+inline Stencil1D ugimp_stencil(double x, const StencilScale& scale) {
+  const double h = scale.h, lp = scale.lp, inv_h = scale.inv_h, inv_hlp = scale.inv_hlp;
   Stencil1D st;
-  const double inv_h = 1 / h, inv_hlp = 1 / (h * lp);
   // The nearest node: the particle's box [x - lp, x + lp] with lp <= h/2 lies
-  // within (nearest - 1) .. (nearest + 1) cells' support.
-  const int nearest = static_cast<int>(std::floor(x * inv_h + 0.5));
+  // within (nearest - 1) .. (nearest + 1) cells' support. floor(t) as the
+  // truncation, one less where it rounded a negative t up (std::floor costs
+  // four times as many instructions without SSE4.1; t is in int range on any
+  // grid).
+  const double t = x * inv_h + 0.5;
+  int nearest = static_cast<int>(t);
+  if (t < nearest) --nearest;
   st.first = nearest - 1;
   for (int k = 0; k < 3; ++k) {
     const double d = x - (st.first + k) * h;
@@ -75,5 +88,7 @@ inline Stencil1D ugimp_stencil(double x, double h, double lp) {
   }
   return st;
 }
+
+inline Stencil1D ugimp_stencil(double x, double h, double lp) { return ugimp_stencil(x, StencilScale(h, lp)); }
 
 }  // namespace hfmpm::solid::mpm

@@ -157,8 +157,7 @@ class Solver {
   template <bool kCracks>
   void p2g();
   // P2G's steps, each run by every thread (transfer.cpp).
-  template <bool kCracks>
-  std::array<std::size_t, 2> p2g_zero_band(std::size_t thread, std::size_t begin, std::size_t end);
+  std::array<std::size_t, 2> p2g_band(std::size_t begin, std::size_t end) const;
   template <bool kCracks>
   void p2g_scatter(std::size_t thread, std::size_t begin, std::size_t end);
   template <bool kCracks>
@@ -168,7 +167,16 @@ class Solver {
   template <bool kCracks>
   void g2p(double dt);
   // Cracks (solver_cracks.cpp)
-  bool near_crack(const Vec2& x) const;
+  // Whether x is within 2.5 h of a crack's box (a particle-node segment is
+  // at most about 2.2 h long, the uGIMP reach); inline: P2G asks it for
+  // every particle.
+  bool near_crack(const Vec2& x) const {
+    const double margin = 2.5 * config_.grid.h;
+    for (const auto& crack : cracks_) {
+      if (crack.near(x, margin)) return true;
+    }
+    return false;
+  }
   // Face loads: the in-situ traction the cut gives up (in_situ_reference) and
   // the fluid's pressure, each when asked.
   void crack_loads(bool in_situ, bool pressure);
@@ -217,12 +225,17 @@ class Solver {
   std::vector<Crack> cracks_;
   // P2G's per-thread accumulators: one cache line per node and field
   // (index node * fields + field), over the span of nodes the thread's
-  // particles reach this step; the spans are reduced into field0_ / field1_.
+  // particles reach this step; the spans are reduced into field0_ / field1_
+  // and zeroed as they are (all zero between P2Gs).
   struct alignas(64) NodeAcc {
-    double m, px, py, fx, fy, ux, uy, pad;
+    Vec2 p = Vec2::Zero();  // momentum
+    Vec2 f = Vec2::Zero();  // force
+    Vec2 u = Vec2::Zero();  // mass-weighted displacement (cracks)
+    double m = 0;           // mass
   };
   std::vector<std::vector<NodeAcc>> thread_acc_;
-  std::vector<std::array<std::size_t, 2>> thread_span_;  // [first, last) node
+  std::vector<std::array<std::size_t, 2>> thread_span_;       // [first, last) node
+  std::vector<std::array<std::size_t, 2>> thread_side_span_;  // [first, last) node with field-1 entries
   std::vector<std::vector<int>> thread_active_;
   // Per particle, cracks only, set by P2G for G2P: bit 15 = near a crack,
   // bit 3 b + a = node (a, b) of its 3 x 3 stencil is in field 1.
