@@ -52,9 +52,14 @@ def case(name, base, km, **changes):
 
 def cases():
     out = []
-    for km in (0.01, 0.1, 1, 10, 100):
+    for km in (0.01, 0.1, 1, 10):
         out.append(case(f"lab-km{km:g}", LAB, km))
         out.append(case(f"field-km{km:g}", FIELD, km))
+    # Km = 100 in the lab rock and fluid opens its crack by 45% of its length
+    # (w0 / L = 0.732 Km^(4/3) (mu' / E' t)^(1/3) at the K-vertex), which
+    # `hfmpm scene` refuses (small strain); water in a 50 MPa rock for 10 s: 4.5%.
+    out.append(case("lab-km100", LAB, 100, E=5e7, mu=1e-4, t=10.0))
+    out.append(case("field-km100", FIELD, 100))
     out += [
         case("lab-E5MPa", LAB, 0.1, E=5e6),
         case("lab-E50MPa", LAB, 0.1, E=5e7),

@@ -79,7 +79,11 @@ class MpmFluidSide final : public coupling::SideModel {
   // The coupled step may hold max_substeps fluid steps (the fluid subcycles).
   double stable_dt() const override {
     double dt = std::numeric_limits<double>::infinity();
-    for (const auto& c : cracks_) dt = std::min(dt, c.solver.stable_dt() * max_substeps_);
+    // The explicit fluid subcycles up to max_substeps times within a coupled
+    // step; the implicit interface step does not (FluidSolver::advance), so
+    // its own limit (advection) is the coupled step's.
+    const double substeps = config_.implicit_interface ? 1.0 : static_cast<double>(max_substeps_);
+    for (const auto& c : cracks_) dt = std::min(dt, c.solver.stable_dt() * substeps);
     return dt;
   }
 

@@ -139,7 +139,7 @@ TEST(SceneBuilder, ToughnessDominatedSceneTakesTheToughnessClosure) {
 // from the minimum (with 6 digits they were not for a cell of 0.00977 m, and
 // the scene was refused).
 TEST(SceneBuilder, EveryProblemOfASweepGivesAValidScene) {
-  int built = 0;
+  int built = 0, refused = 0;
   for (const double e : {5e6, 1e7, 2e10, 3e10}) {
     for (const double k_ic : {1e2, 3e4, 1e6}) {
       for (const double cells : {8.0, 13.0, 20.0, 37.0}) {
@@ -154,13 +154,28 @@ TEST(SceneBuilder, EveryProblemOfASweepGivesAValidScene) {
           p.set_notch_m(std::min(m_vertex(e_prime, mu, q, t).half_length, k_vertex(e_prime, k_ic, q, t).half_length) /
                         6);
           SCOPED_TRACE(std::to_string(e) + " " + std::to_string(k_ic) + " " + std::to_string(cells));
+          // Refused where the expected mouth opening passes 20% of the half-length (small strain).
+          const Vertex m = m_vertex(e_prime, mu, q, t), k = k_vertex(e_prime, k_ic, q, t);
+          const bool toughness = toughness_number(e_prime, mu, q, k_ic) >= 1;
+          const double aspect = (toughness ? k : m).opening / std::min(m.half_length, k.half_length);
+          if (aspect > 0.2) {
+            try {
+              build_scene(p);
+              ADD_FAILURE() << "accepted an opening of " << aspect << " of the half-length";
+            } catch (const ProblemError& error) {
+              EXPECT_THAT(error.what(), HasSubstr("allowed: an opening of at most 20% of the half-length"));
+            }
+            ++refused;
+            continue;
+          }
           EXPECT_NO_THROW(checked(build_scene(p)));
           ++built;
         }
       }
     }
   }
-  EXPECT_EQ(built, 96);
+  EXPECT_EQ(built + refused, 96);
+  EXPECT_GE(built, 80);  // the 5 and 10 MPa rocks at K_Ic = 1 MPa m^0.5 are refused
   // A notch so short that two cells along it would put more than 200 along the crack.
   problem::Problem tiny = field_problem();
   tiny.set_notch_m(0.01);
@@ -187,14 +202,25 @@ TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
   shallow.mutable_in_situ()->set_normal_to_crack_pa(1e4);  // the K-vertex's 17.8 kPa against 10 kPa
   ASSERT_EQ(build_scene(shallow).derived.cautions.size(), 1u);
   EXPECT_THAT(build_scene(shallow).derived.cautions[0], HasSubstr("the fluid lag is then not small"));
-  // A crack as wide as a sizeable part of its length (the matrix's lab Km = 100:
-  // K_Ic = 433 kPa m^0.5 in a 10 MPa rock opens 19 mm over 42 mm).
-  problem::Problem fat = toughness_problem();
-  fat.mutable_rock()->set_toughness_pa_sqrt_m(4.33e5);
-  fat.set_notch_m(0.02);  // its K-vertex grows to 0.094 m
-  const auto cautions = build_scene(fat).derived.cautions;
+  // A crack as wide as a sizeable part of its length: a caution from 5%
+  // (K_Ic = 140 kPa m^0.5 in a 10 MPa rock: 10%) ...
+  problem::Problem plump = toughness_problem();
+  plump.mutable_rock()->set_toughness_pa_sqrt_m(1.4e5);
+  plump.set_notch_m(0.02);
+  const auto cautions = build_scene(plump).derived.cautions;
   ASSERT_FALSE(cautions.empty());
   EXPECT_THAT(cautions.back(), HasSubstr("% of the half-length: strains of that order are outside"));
+  // ... and refused from 20% (the matrix's first lab Km = 100: K_Ic = 433 kPa
+  // m^0.5, 45%, stopped on a pressure spike with its faces 9 mm apart over 7 mm).
+  problem::Problem fat = plump;
+  fat.mutable_rock()->set_toughness_pa_sqrt_m(4.33e5);
+  try {
+    build_scene(fat);
+    FAIL() << "a crack opening 45% of its length was accepted";
+  } catch (const ProblemError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("of the expected half-length"));
+    EXPECT_THAT(e.what(), HasSubstr("allowed: an opening of at most 20% of the half-length"));
+  }
   EXPECT_EQ(build_scene(toughness_problem()).derived.cautions.size(), 0u);  // 2% of its half-length
 }
 

@@ -108,6 +108,7 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
   const double rho0 = config_.density;
   const auto& in = config_.inlet;
   t.squeezed = -1;
+  t.why = "";
   // Particle pressures from the element pressures, and what the faces carry.
   t.pp.assign(np, 0.0);
   for (std::size_t p = 0; p < np; ++p)
@@ -141,6 +142,7 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
     t.b[p] = part.end(p) + dt * interpolate(arc, t.v, part.end(p));
     if (!(t.b[p] > t.a[p])) {
       t.squeezed = static_cast<std::ptrdiff_t>(p);
+      t.why = "its ends cross";
       return false;
     }
   }
@@ -156,7 +158,13 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
       t.mass[0] -= t.mass[0] * (all > 0 ? outside / all : -t.a[0] / (t.b[0] - t.a[0]));
     }
     t.a[0] = 0;
-    if (!(t.b[0] > 0) || !(t.mass[0] > 0)) return false;
+    if (!(t.b[0] > 0) || !(t.mass[0] > 0)) {
+      // The inlet particle flows back out of the mouth, or empties: merged
+      // with its neighbour it is long enough to stay in (Squeezed below).
+      t.squeezed = 0;
+      t.why = "the inlet particle leaves through the mouth";
+      return false;
+    }
     // A wetted outlet cuts the last particle at the end of the crack (outlet()).
     if (outlet_wetted_) {
       const std::size_t q = np - 1;
@@ -169,7 +177,11 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
         t.mass[q] += rho0 / eos_.volume_ratio(p_out) * integrate(arc, t.width, t.b[q], end);
       }
       t.b[q] = end;
-      if (!(t.b[q] > t.a[q])) return false;
+      if (!(t.b[q] > t.a[q])) {
+        t.squeezed = static_cast<std::ptrdiff_t>(q);
+        t.why = "the outlet particle leaves through the outlet";
+        return false;
+      }
     }
   }
   // The crack moves along itself and carries the fluid (set_crack maps the
@@ -270,6 +282,12 @@ void FluidSolver::step_implicit(double dt) {
           std::ostringstream out;
           out << "fluid: crack " << grid_.crack_id() << ": the implicit interface step of " << dt << " s " << what
               << " (stable dt " << stable_dt() << " s); the step is too large";
+          if (trial.squeezed >= 0) {
+            const auto q = static_cast<std::size_t>(trial.squeezed);
+            out << " (particle " << q << " of " << particles_.size() << " at s = " << particles_.start(q) << " to "
+                << particles_.end(q) << " m, velocity " << particles_.velocity[q] << " m/s: " << trial.why << "; "
+                << attempt << " merges tried)";
+          }
           throw std::runtime_error(out.str());
         };
         if (!interface_trial(P, dt, trial, g)) {

@@ -254,14 +254,14 @@ double FluidSolver::stable_dt() const {
   if (grid_.empty()) throw std::logic_error("fluid: set_crack() must be called before stable_dt()");
   double shortest = grid_.min_spacing();
   if (config_.implicit_interface) {
-    // Pressure waves are implicit; a particle end must not cross more than a
-    // fraction of its own length (or of an element) in a step.
-    double speed = 0;
+    // Pressure waves are implicit; a particle must not move more than a
+    // fraction of its own length, nor of the shortest element, in a step.
+    double limit = std::numeric_limits<double>::infinity();
     for (std::size_t p = 0; p < particles_.size(); ++p) {
-      shortest = std::min(shortest, particles_.length[p]);
-      speed = std::max(speed, std::abs(particles_.velocity[p]));
+      const double speed = std::abs(particles_.velocity[p]);
+      if (speed > 0) limit = std::min(limit, std::min(particles_.length[p], shortest) / speed);
     }
-    return speed > 0 ? config_.cfl * shortest / speed : std::numeric_limits<double>::infinity();
+    return config_.cfl * limit;
   }
   double speed = std::sqrt(config_.bulk_modulus / config_.density);
   for (std::size_t p = 0; p < particles_.size(); ++p) {

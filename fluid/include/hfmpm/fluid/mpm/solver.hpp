@@ -206,6 +206,7 @@ class FluidSolver {
   struct Trial {
     std::vector<double> pp, nodal, scratch, force, v, width, a, b, mass, volume, volume0;
     std::ptrdiff_t squeezed = -1;  // a particle the step turned inside out (the trial failed), or -1
+    const char* why = "";          // what failed the trial, for the error message
   };
   // Residual P_e - p_Tait(V_e / V0_e) of element pressures P after a trial step of dt.
   bool interface_trial(const std::vector<double>& P, double dt, Trial& t, std::vector<double>& residual) const;
