@@ -5,7 +5,8 @@
 // value per run. Every run must end normally and stay sane:
 // - no NaN or Inf in any history column;
 // - the kinetic energy stays below 1e-2 of the work the inlet pressure has done
-//   once the 0.05 s ramp is over (quasi-static loading; measured below 1e-3);
+//   once the 0.05 s ramp is over (from 0.1 s; quasi-static loading; measured
+//   below 1e-3), and from 0.2 s without confinement (below);
 // - the inlet pressure is never negative;
 // - the fluid's mass: the injected volume equals the integral of the ramped
 //   inlet rate (to the trapezoid error of the substep holding the ramp's kink),
@@ -15,11 +16,14 @@
 //   stretched at zero pressure, J > 1, count empty space; measured up to 2.7x
 //   without confinement. Each particle's mass is constant and merging adds
 //   masses, so the mass itself is conserved by construction.)
+// The scene is water (K = 2 GPa) with the implicit interface scheme since
+// issue 17; its former defaults (a 2 MPa fluid, Gauss-Seidel) are one case.
 // Inputs that do blow up must stop the run within a few steps, exit non-zero,
 // name what blew up with what to change, and leave their output readable: a
 // flow-rate inlet into a 10 nm film (the runaway particle and the pressure
-// spike), and a water-stiff fluid (K = 2 GPa: the coupler's energy check at
-// step 20; docs/stability.md). Water at a sixth of the step is sane.
+// spike), and water with Gauss-Seidel at the scene's step (the coupler's
+// energy check at step 20; docs/stability.md). Water with Gauss-Seidel at a
+// sixth of the step is sane.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -36,7 +40,8 @@ namespace {
 struct Case {
   const char* name;
   std::vector<std::string> sets;
-  double initial_volume;  // m^2 of fluid at t = 0 (film x notch), at zero pressure to within the Tait compression
+  double initial_volume;    // m^2 of fluid at t = 0 (film x notch), at zero pressure to within the Tait compression
+  double quiet_from = 0.1;  // s: the kinetic-energy bound holds from here (two ramps)
 };
 
 constexpr double kQ = 1.25e-4, kRamp = 0.05;
@@ -70,7 +75,7 @@ void expect_sane(const Case& c) {
     const double zero_pressure = injected[i] + c.initial_volume;
     EXPECT_GT(volume[i], 0.5 * zero_pressure) << c.name << " at t = " << t[i];
     if (i > 0) work += 0.5 * (p_in[i] + p_in[i - 1]) * (injected[i] - injected[i - 1]);
-    if (t[i] > 2 * kRamp) {
+    if (t[i] > c.quiet_from) {
       EXPECT_LT(ke[i], 1e-2 * work) << c.name << " at t = " << t[i];
       ke_ratio = std::max(ke_ratio, ke[i] / work);
     }
@@ -88,28 +93,41 @@ TEST(Stability, SoftFluid) { expect_sane({"bulk_1MPa", {"fluid.mpm.bulk_modulus_
 TEST(Stability, ThinFluid) { expect_sane({"mu_1e-4", {"fluid.mpm.viscosity_pa_s=1e-4"}, kFilm}); }
 TEST(Stability, ThickFluid) { expect_sane({"mu_1", {"fluid.mpm.viscosity_pa_s=1"}, kFilm}); }
 TEST(Stability, LargePreOpening) { expect_sane({"film_1mm", {"fluid.mpm.virtual_opening_m=1e-3"}, 1e-3 * 0.15}); }
+// Without confinement the body rings longer at the start: the faces, loaded
+// from rest with water and no in-situ stress to hold them, overshoot (the crack
+// opens to twice the fluid's volume, which cavitates) and the kinetic energy is
+// 4.1% of the inlet work at 0.1 s, 1.0% at 0.15 s, 0.27% at 0.2 s, 7e-5 at the
+// end (with the former 2 MPa fluid and Gauss-Seidel, whose compression
+// cushions the start: 0.58% at 0.1 s). The bound holds from 0.2 s.
 TEST(Stability, NoConfinement) {
   expect_sane(
       {"unconfined",
        {"solid.mpm.regions=[{material: \"rock\" rectangle { x_min_m: 0 y_min_m: -1.05 x_max_m: 1.05 y_max_m: 1.05 }}]",
         "solid.mpm.tractions=[]", "fluid.mpm.initial_fill.pressure_pa=0", "fluid.mpm.lag_pressure_pa=0"},
-       kFilm});
+       kFilm,
+       0.2});
 }
 TEST(Stability, TenTimesTheEndTime) { expect_sane({"long", {"time.end_s=15"}, kFilm}); }
-// Water (K = 2 GPa) blows up at the scene's step (below) but not at a sixth of
-// it: the coupled step's limit falls with the fluid's stiffness, and nothing
-// yet shrinks it automatically (docs/stability.md, item 1). 15,654 steps.
-TEST(Stability, WaterAtASixthOfTheStep) {
-  expect_sane({"bulk_2GPa_step0.15", {"fluid.mpm.bulk_modulus_pa=2e9", "time.safety_factor=0.15"}, kFilm});
-}
+// The scene's water at half its step: the same checks (the step chosen by
+// the program is not at the edge of stability).
+TEST(Stability, WaterAtHalfTheStep) { expect_sane({"water_step0.45", {"time.safety_factor=0.45"}, kFilm}); }
 
-// The implicit interface scheme (issue 17): a 1 GPa fluid at the scene's own
-// step, with no step setting, is sane (Gauss-Seidel needs a third of the step
-// for it). Measured KE / inlet work 2.4e-3. (Water passes every check but the
-// kinetic energy, which a contact transient lifts to 1.02e-2 for one row at
-// 0.25 s: docs/stability.md.)
-TEST(Stability, StiffFluidAtTheScenesStepWithTheImplicitScheme) {
-  expect_sane({"bulk_1GPa_implicit", {"coupling.scheme=IMPLICIT", "fluid.mpm.bulk_modulus_pa=1e9"}, kFilm});
+// The scheme and fluid the scene had before issue 17 (Gauss-Seidel, a 2 MPa
+// fluid, the lag at the confining stress, half-cell growth): still sane, and
+// water with Gauss-Seidel is sane at a sixth of the step (it blows up at the
+// full step: WaterStiffFluidStopsTheRunWithADiagnosis).
+const std::vector<std::string> kGaussSeidel = {"coupling.scheme=GAUSS_SEIDEL", "fluid.mpm.lag=FIXED_PRESSURE",
+                                               "solid.mpm.fracture.growth_cells=0.5",
+                                               "solid.mpm.fracture.max_lag_cells=0.5"};
+std::vector<std::string> gauss_seidel(std::vector<std::string> more) {
+  more.insert(more.begin(), kGaussSeidel.begin(), kGaussSeidel.end());
+  return more;
+}
+TEST(Stability, GaussSeidelSoftFluid) {
+  expect_sane({"gauss_seidel_2MPa", gauss_seidel({"fluid.mpm.bulk_modulus_pa=2e6"}), kFilm});
+}
+TEST(Stability, GaussSeidelWaterAtASixthOfTheStep) {
+  expect_sane({"gauss_seidel_water_step0.15", gauss_seidel({"time.safety_factor=0.15"}), kFilm});
 }
 
 // The step the coupler chooses and the term it names (run.json
@@ -142,9 +160,8 @@ TEST(Stability, TheStepIsChosenFromTheSidesAndNamed) {
     return std::make_pair(json_string(manifest, "dt_limited_by"), json_number(manifest, "dt_max_s"));
   };
   const auto [explicit_limit, explicit_dt] =
-      run_with("explicit", {"fluid.mpm.bulk_modulus_pa=2e9", "fluid.mpm.max_substeps=1", "time.safety_factor=0.5"});
-  const auto [implicit_limit, implicit_dt] =
-      run_with("implicit", {"fluid.mpm.bulk_modulus_pa=2e9", "fluid.mpm.max_substeps=1", "coupling.scheme=IMPLICIT"});
+      run_with("explicit", gauss_seidel({"fluid.mpm.max_substeps=1", "time.safety_factor=0.5"}));
+  const auto [implicit_limit, implicit_dt] = run_with("implicit", {"fluid.mpm.max_substeps=1"});
   std::printf("explicit: %s, dt %.3e s; implicit: %s, dt %.3e s\n", explicit_limit.c_str(), explicit_dt,
               implicit_limit.c_str(), implicit_dt);
   EXPECT_EQ(explicit_limit.rfind("fluid: sound speed", 0), 0u) << explicit_limit;
@@ -158,10 +175,16 @@ TEST(Stability, TheStepIsChosenFromTheSidesAndNamed) {
 // must stop the run at the first particle that moves more than a cell in a
 // step, say which and where, name the face pressure and what to change, and
 // keep the output.
-void expect_runaway_diagnosed(const char* name, const std::string& set, const std::vector<const char*>& parts) {
+void expect_runaway_diagnosed(const char* name, const std::vector<std::string>& sets,
+                              const std::vector<const char*>& parts) {
   const auto out = scratch_dir(std::string("stability_") + name);
-  const auto result =
-      run({bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"), "--out", out, "--quiet", "--set", set}, 300);
+  std::vector<std::string> argv = {bin("hfmpm"), "run", source("scenarios/stability-kgd.scene"),
+                                   "--out",      out,   "--quiet"};
+  for (const auto& set : sets) {
+    argv.push_back("--set");
+    argv.push_back(set);
+  }
+  const auto result = run(argv, 300);
   EXPECT_NE(result.exit_code, 0);
   for (const char* part : parts) {
     EXPECT_NE(result.err.find(part), std::string::npos) << part << " not in: " << result.err;
@@ -181,7 +204,7 @@ void expect_runaway_diagnosed(const char* name, const std::string& set, const st
 // solid's runaway check named it at step 59).
 TEST(Stability, PressureSpikeStopsTheRunWithADiagnosis) {
   expect_runaway_diagnosed(
-      "spike", "fluid.mpm.virtual_opening_m=1e-8",
+      "spike", gauss_seidel({"fluid.mpm.bulk_modulus_pa=2e6", "fluid.mpm.virtual_opening_m=1e-8"}),
       {"at step", "compressed to", "times its bulk modulus", "fluid.mpm.virtual_opening_m", "time.safety_factor"});
 }
 // The water-stiff fluid now trips the coupler's energy check first: at the
@@ -189,7 +212,7 @@ TEST(Stability, PressureSpikeStopsTheRunWithADiagnosis) {
 // what the fluid can have given it), before any particle moves a cell (the
 // runaway check fired at step 59).
 TEST(Stability, WaterStiffFluidStopsTheRunWithADiagnosis) {
-  expect_runaway_diagnosed("bulk_2GPa", "fluid.mpm.bulk_modulus_pa=2e9",
+  expect_runaway_diagnosed("bulk_2GPa", gauss_seidel({}),
                            {"energy is being created", "at step", "kinetic energy", "fluid.mpm.bulk_modulus_pa"});
 }
 
