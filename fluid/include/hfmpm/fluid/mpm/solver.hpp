@@ -95,7 +95,9 @@ class FluidSolver {
   int advance(double dt_total);
   // s, cfl * min(smallest particle length, smallest node spacing) / c, with
   // c the fastest sound speed of the particles (>= sqrt(K / rho0)); with
-  // implicit_interface, c is the fastest particle speed (+inf at rest).
+  // implicit_interface (pressure waves implicit, advection explicit) the
+  // smallest over the particles of cfl * min(l_p, smallest node spacing) /
+  // |v_p| (+inf at rest).
   double stable_dt() const;
   // One implicit interface step of dt (implicit.cpp): the element pressures
   // P_e over the step are solved so that each element's fluid, after the
