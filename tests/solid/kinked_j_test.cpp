@@ -16,8 +16,10 @@
 // (growth_energy, kIrwinBend).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 #include "oblique_growth.hpp"
@@ -27,7 +29,11 @@ namespace {
 
 constexpr double kKink = 67 * kPi / 180;  // rad, counter-clockwise at the end tip (point-symmetric at the start)
 
-// The oblique tests' crack, with a kink of kKink and a quarter cell at each
+// Cells, the kink's length (HFMPM_KINK_CELLS, default a quarter cell, the
+// growth step of the oblique tests).
+double kink_cells() { return std::getenv("HFMPM_KINK_CELLS") ? std::atof(std::getenv("HFMPM_KINK_CELLS")) : 0.25; }
+
+// The oblique tests' crack, with a kink of kKink and kink_cells() at each
 // tip (or without it: the parent).
 std::vector<Vec2> crack_points(double h, bool kinked) {
   const Vec2 centre(h / 2, 0);
@@ -35,9 +41,15 @@ std::vector<Vec2> crack_points(double h, bool kinked) {
   const Vec2 dir(std::cos(kPi / 4), std::sin(kPi / 4));
   const Vec2 ahead(std::cos(kPi / 4 + kKink), std::sin(kPi / 4 + kKink));
   std::vector<Vec2> pts;
-  if (kinked) pts.push_back(centre - kA * dir - 0.25 * h * ahead);
+  // The kink in segments of at most half a cell (as growth makes them).
+  const int pieces = std::max(1, static_cast<int>(std::ceil(kink_cells() / 0.5 - 1e-9)));
+  if (kinked) {
+    for (int k = pieces; k > 0; --k) pts.push_back(centre - kA * dir - kink_cells() * h * k / pieces * ahead);
+  }
   for (int k = 0; k <= segments; ++k) pts.push_back(centre + (-kA + 2 * kA * k / segments) * dir);
-  if (kinked) pts.push_back(centre + kA * dir + 0.25 * h * ahead);
+  if (kinked) {
+    for (int k = 1; k <= pieces; ++k) pts.push_back(centre + kA * dir + kink_cells() * h * k / pieces * ahead);
+  }
   return pts;
 }
 
