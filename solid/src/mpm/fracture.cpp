@@ -34,8 +34,13 @@
 // faces carry no traction, on faces off it (a kink in the domain) they do,
 // and face_work adds that term (and J's -W n1). Then
 // M_a = 2 K_a / E', so K_I = E' M_1 / 2 and K_II = E' M_2 / 2, each linear
-// in the computed field. J stays the EDI above (the growth criterion);
-// K_I^2 + K_II^2 = E' J only to discretization error. Like J, M assumes one
+// in the computed field. J stays the EDI above (the growth criterion, but
+// where the crack bends by more than kIrwinBend within a one-material
+// domain: growth_energy); K_I^2 + K_II^2 = E' J only to discretization
+// error, and after a kink shorter than a cell not even that: J's face term
+// near the kink's corner is of order K^2/E' and sub-cell, and J gives the
+// parent crack's J vector on the kink's direction (tests/solid/
+// kinked_j_test.cpp). Like J, M assumes one
 // material in the domain (across an interface it lacks the terms of the
 // material gradient).
 // Measured (K_I, K_II error; before: J split by the ratio of sliding to
