@@ -226,13 +226,15 @@ Turned turn_in_anisotropic_stress(double h, double length) {
 // point symmetry about the centre (h / 2, 0): the tips' new particles and the
 // points where the paths cross y = +-1.5 m symmetric within one growth step
 // (a quarter cell).
-// Right after the first kink J is 31-38% below (K_I^2 + K_II^2)/E', also in a
-// re-solve from rest, by different amounts at the two tips, and J is the
-// growth criterion: the start tip grows its second and third steps before
-// the end tip's second (counts 3 : 1), and ends one step ahead. So the tips
-// are compared step by step (the k-th new particle of each, point-symmetric
-// within a step), and the counts are asserted within two steps, not the one
-// issue 18 asks (docs/verification.md, open).
+// Right after the first kink J's domain form is half (K_I^2 + K_II^2)/E', also
+// in a re-solve from rest (it gives the parent crack's J vector on the kink's
+// direction; tests/solid/kinked_j_test.cpp), by different amounts at the two
+// tips. While J drove growth there, the start tip grew its second and third
+// steps before the end tip's second (counts 3 : 1) and ended one step ahead
+// (25 : 24). Growth there is now driven by (K_I^2 + K_II^2)/E' (the crack
+// bends by more than 30 deg in the domain): the tips grow at the same checks
+// (24 : 24). Asserted: the k-th new particles of the two tips point-symmetric
+// within a step, and the counts within one step (issue 18).
 // HFMPM_OBLIQUE_CELLS=n runs at a/n.
 TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {
   const int cells = std::getenv("HFMPM_OBLIQUE_CELLS") ? std::atoi(std::getenv("HFMPM_OBLIQUE_CELLS")) : 5;
@@ -242,7 +244,7 @@ TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {
   EXPECT_NEAR(t.start_heading, -90, 5);
   const Vec2 centre(h / 2, 0);
   const double step = 0.25 * h;
-  EXPECT_LE(t.count_gap, 2) << "the tips of a point-symmetric crack grew apart";
+  EXPECT_LE(t.count_gap, 1) << "the tips of a point-symmetric crack grew apart";
   EXPECT_LT(t.step_gap, step);
   EXPECT_LT(std::abs(t.end_crossing - centre.x() + (t.start_crossing - centre.x())), step);
 }

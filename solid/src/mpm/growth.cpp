@@ -29,7 +29,9 @@ constexpr double kMinSegmentCells = 0.5;
 double growth_energy(const TipResult& tip, bool mode_one_only) {
   const double k1 = std::max(0.0, tip.k1), sum = tip.k1 * tip.k1 + tip.k2 * tip.k2;
   const double driving = k1 * k1 + (mode_one_only ? 0.0 : tip.k2 * tip.k2);
-  return sum > 0 ? tip.j * driving / sum : tip.j;
+  const bool irwin = tip.bend > kIrwinBend && tip.one_material && sum > 0;
+  const double g = irwin ? sum / tip.modulus : tip.j;
+  return sum > 0 ? g * driving / sum : g;
 }
 
 int Solver::propagate() {

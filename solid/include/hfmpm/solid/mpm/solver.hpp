@@ -41,12 +41,26 @@ struct TipResult {
   double toughness = 0;            // J/m^2, J_Ic of the material at the tip
   double modulus = 0;              // Pa, plane-strain E' there
   std::size_t material = 0;        // index of the material at the tip
+  // rad: the largest angle between `direction` and a crack segment within the
+  // J domain (0 on a straight crack), and whether the domain's particles are
+  // all of the tip's material; they decide which energy drives growth
+  // (growth_energy).
+  double bend = 0;
+  bool one_material = true;
 };
 
-// J/m^2: the energy release rate that drives growth, J without the share of
-// a negative K_I (a crack closed in compression): J (max(K_I, 0)^2 + K_II^2)
+// rad: where the crack bends by more than this within a one-material J
+// domain, growth is driven by Irwin's (K_I^2 + K_II^2) / E' instead of J
+// (growth_energy; docs/solid.md, "J after a kink").
+inline constexpr double kIrwinBend = 0.5235987755982988;  // 30 deg
+
+// J/m^2: the energy release rate that drives growth, G without the share of
+// a negative K_I (a crack closed in compression): G (max(K_I, 0)^2 + K_II^2)
 // / (K_I^2 + K_II^2); with mode_one_only (straight growth by symmetry) the
-// K_II^2 term is left out of the numerator. A tip grows when it reaches the
+// K_II^2 term is left out of the numerator. G is J, or (K_I^2 + K_II^2) / E'
+// where the crack bends by more than kIrwinBend within a one-material domain:
+// J's domain form then misses the face term of the kink's corner, which sits
+// within a fraction of a cell of the tip. A tip grows when it reaches the
 // toughness.
 double growth_energy(const TipResult& tip, bool mode_one_only = false);
 
@@ -198,6 +212,7 @@ class Solver {
   };
   struct TipSums {
     double j = 0, m1 = 0, m2 = 0;  // J and the interaction integrals
+    bool one_material = true;      // all particles in the domain are of the tip's material
   };
   static TipFrame tip_frame(const Crack& crack, bool at_end);
   std::size_t material_at(const Vec2& x) const;
