@@ -291,8 +291,15 @@ void FluidSolver::step_implicit(double dt) {
           throw std::runtime_error(out.str());
         };
         if (!interface_trial(P, dt, trial, g)) {
-          std::fill(P.begin(), P.end(), 0.0);  // no pressure moves no particle end far
-          if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out at zero pressure");
+          // Uniform at the pressure the front pushes against: no gradient
+          // and a balanced front move no particle end far. (At zero
+          // pressure a front closure of 20 MPa against a 20 MPa confinement
+          // drove the front back through its particle in a built field case.)
+          std::fill(P.begin(), P.end(), front_counter_pressure());
+          if (!interface_trial(P, dt, trial, g)) {
+            std::fill(P.begin(), P.end(), 0.0);  // no pressure at all
+            if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out at zero pressure");
+          }
         }
         const double K = config_.bulk_modulus;
         auto min_form = [&](const std::vector<double>& p, const std::vector<double>& gg, std::vector<double>& out) {
