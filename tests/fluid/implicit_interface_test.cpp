@@ -61,7 +61,9 @@ struct Result {
   double worst_mismatch = 0, net = 0, volume_gain = 0, injected = 0, mass_error = 0, acoustic_dt = 0;
 };
 
-Result run(double bulk_modulus, double dt, int steps) {
+// Water-like fluid injected at kQ after a ramp over 20 steps of dt, with
+// implicit interface steps; walls at rest, kW0 open, closed at the tip.
+FluidConfig channel_config(double bulk_modulus, double dt) {
   FluidConfig c;
   c.density = 1000;
   c.bulk_modulus = bulk_modulus;
@@ -69,11 +71,34 @@ Result run(double bulk_modulus, double dt, int steps) {
   c.implicit_interface = true;
   c.inlet.kind = InletConfig::Kind::FlowRate;
   c.inlet.flow_rate = TimeFunction::table({0, 20 * dt}, {0, kQ});
+  return c;
+}
+Walls initial_walls() {
   Walls walls;
   walls.s = test::uniform_nodes(0.2, 10);
   walls.w.assign(walls.s.size(), kW0);
   walls.w.back() = 0;
   walls.r.assign(walls.s.size(), 0.0);
+  return walls;
+}
+
+// One coupled step: the fluid's implicit step against the walls' response,
+// then the walls move under the pressures it reported. Returns them.
+std::vector<double> step_with_walls(FluidSolver& f, Walls& walls, double dt) {
+  f.set_crack(report(walls));
+  f.step_implicit(dt);
+  auto p = f.nodal_pressure();  // what the walls carry over this step
+  for (std::size_t i = 0; i + 1 < walls.s.size(); ++i) {
+    walls.r[i] += dt * kC * (p[i] - kSigma);
+    walls.w[i] = std::max(0.0, walls.w[i] + dt * walls.r[i]);
+  }
+  f.set_crack(report(walls));
+  return p;
+}
+
+Result run(double bulk_modulus, double dt, int steps) {
+  const FluidConfig c = channel_config(bulk_modulus, dt);
+  Walls walls = initial_walls();
   FluidSolver f(c);
   f.set_crack(report(walls));
   f.fill(0.2, kSigma);
@@ -83,14 +108,7 @@ Result run(double bulk_modulus, double dt, int steps) {
   double volume0 = 0;
   for (std::size_t i = 0; i + 1 < walls.s.size(); ++i) volume0 += 0.5 * (walls.w[i] + walls.w[i + 1]) * 0.02;
   for (int k = 0; k < steps; ++k) {
-    f.set_crack(report(walls));
-    f.step_implicit(dt);
-    const auto p = f.nodal_pressure();  // what the walls carry over this step
-    for (std::size_t i = 0; i + 1 < walls.s.size(); ++i) {
-      walls.r[i] += dt * kC * (p[i] - kSigma);
-      walls.w[i] = std::max(0.0, walls.w[i] + dt * walls.r[i]);
-    }
-    f.set_crack(report(walls));
+    const auto p = step_with_walls(f, walls, dt);
     if (k > 0) out.worst_mismatch = std::max(out.worst_mismatch, f.interface_mismatch());
     out.net = std::max(out.net, p[0] - kSigma);
   }
@@ -128,33 +146,15 @@ TEST(ImplicitInterface, WallsCarryThePressureTheFluidHasAtTheEndOfTheStep) {
 // the fastest), which is smaller whenever the shortest particle is not the
 // fastest.
 TEST(ImplicitInterface, StableStepIsEachParticlesAdvectionLimit) {
-  FluidConfig c;
-  c.bulk_modulus = 2e9;
-  c.viscosity = 1e-3;
-  c.implicit_interface = true;
-  c.inlet.kind = InletConfig::Kind::FlowRate;
-  c.inlet.flow_rate = TimeFunction::table({0, 0.02}, {0, kQ});
-  Walls walls;
-  walls.s = test::uniform_nodes(0.2, 10);
-  walls.w.assign(walls.s.size(), kW0);
-  walls.w.back() = 0;
-  walls.r.assign(walls.s.size(), 0.0);
+  const double dt = 1e-3;
+  const FluidConfig c = channel_config(2e9, dt);
+  Walls walls = initial_walls();
   FluidSolver f(c);
   f.set_crack(report(walls));
   EXPECT_TRUE(std::isinf(f.stable_dt()));  // no fluid moves yet
   f.fill(0.2, kSigma);
   EXPECT_TRUE(std::isinf(f.stable_dt()));  // at rest
-  const double dt = 1e-3;
-  for (int k = 0; k < 100; ++k) {
-    f.set_crack(report(walls));
-    f.step_implicit(dt);
-    const auto p = f.nodal_pressure();
-    for (std::size_t i = 0; i + 1 < walls.s.size(); ++i) {
-      walls.r[i] += dt * kC * (p[i] - kSigma);
-      walls.w[i] = std::max(0.0, walls.w[i] + dt * walls.r[i]);
-    }
-    f.set_crack(report(walls));
-  }
+  for (int k = 0; k < 100; ++k) step_with_walls(f, walls, dt);
   const auto& part = f.particles();
   double expected = std::numeric_limits<double>::infinity(), shortest = 0.02, fastest = 0;
   for (std::size_t q = 0; q < part.size(); ++q) {
