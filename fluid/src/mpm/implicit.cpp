@@ -301,7 +301,11 @@ void FluidSolver::step_implicit(double dt) {
             // solve ends elsewhere (Stability.LargePreOpening's kinetic
             // energy rose to 7% of the inlet's work).
             std::fill(P.begin(), P.end(), front_counter_pressure());
-            if (!interface_trial(P, dt, trial, g)) fail("turns a particle inside out at zero pressure");
+            if (!interface_trial(P, dt, trial, g)) {
+              fail(
+                  "turns a particle inside out from every start (the last step's pressures, zero, and the front's "
+                  "counter-pressure)");
+            }
           }
         }
         const double K = config_.bulk_modulus;
