@@ -20,6 +20,13 @@ toughness Km selects, at the history rows where the crack is at least three time
 initial length. Uses Debian's python3-numpy, python3-matplotlib and python3-h5py
 (tools/bootstrap.sh installs them).
 
+--reference transition (the default) prints the errors against the solution at the run's Km
+between the vertices (tools/kgd_transition.py: the same model, zero lag, no leak-off, solved
+for any Km; it reduces to the vertices, within 0.04% for Km <= 0.1 and 0.1% for Km >= 10, and
+covers 1 <= Km <= 4 where neither vertex applies); --reference vertex prints them against the
+vertex Km selects, as before (nothing between Km = 1 and 4); --reference gdk against
+Geertsma-de Klerk. The plots show all of them.
+
 References (E' = E/(1-nu^2), mu' = 12 mu, K' = sqrt(32/pi) K_Ic, Q total):
   M-vertex (Spence and Sharp 1985; Adachi and Detournay 2002; Detournay 2004):
     l = 0.6152 (E' Q^3 t^4 / mu')^(1/6), w0 = 1.126 (mu' Q^3 t^2 / E')^(1/6),
@@ -30,6 +37,8 @@ References (E' = E/(1-nu^2), mu' = 12 mu, K' = sqrt(32/pi) K_Ic, Q total):
   Geertsma and de Klerk (1969), q = Q/2 into one wing, G = E / (2 (1 + nu)):
     w0 = 1.32 (8 (1 - nu) mu q^3 / G)^(1/6) t^(1/3), l = 0.48 (8 G q^3 / ((1 - nu) mu))^(1/6) t^(2/3)
   Dimensionless toughness Km = K' / (E'^3 mu' Q)^(1/4): M-vertex for Km <~ 1, K-vertex for Km >~ 4.
+  Between (and for every Km): tools/kgd_transition.py, l = gamma(Km) (E' Q^3 t^4 / mu')^(1/6),
+    w0 = Omega0(Km) (mu' Q^3 t^2 / E')^(1/6), p0 = Pi0(Km) (mu' E'^2 / t)^(1/3).
 t0 shifts the simulated time for a ramped injection (t_eff = t - t0; half the ramp time).
 """
 import argparse
@@ -38,6 +47,9 @@ import csv
 import math
 import os
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import kgd_transition  # noqa: E402  (the solution between the vertices; its table, standard library only)
 
 
 def vertices(E, nu, mu, Q, KIc, t):
@@ -119,9 +131,10 @@ def main():
     for name in ("E", "nu", "mu", "Q", "KIc", "sigma0", "t0"):
         ap.add_argument("--" + name, type=float, help="overrides the value from RUN/scene.json")
     ap.add_argument("--out", help="PNG path (default RUN/kgd.png)")
-    ap.add_argument("--reference", choices=("vertex", "gdk"), default="vertex",
-                    help="print errors against the vertex Km selects (default) or Geertsma-de Klerk "
-                         "(length and opening; no pressure)")
+    ap.add_argument("--reference", choices=("transition", "vertex", "gdk"), default="transition",
+                    help="print errors against the solution at the run's Km (tools/kgd_transition.py; default), "
+                         "the vertex Km selects (none for 1 <= Km <= 4) or Geertsma-de Klerk (length and opening; "
+                         "no pressure)")
     a = ap.parse_args()
     from_scene = scene_parameters(a.run)
     for name in ("E", "nu", "mu", "Q", "KIc", "sigma0", "t0"):
@@ -140,6 +153,14 @@ def main():
     if a.reference == "gdk":
         compare = 2
         print("errors against Geertsma-de Klerk (q = Q/2 into the wing; no pressure reference)")
+    elif a.reference == "transition":
+        compare = 3
+        print("errors against the solution at this Km (tools/kgd_transition.py)")
+
+    def reference(te):
+        if compare == 3:
+            return kgd_transition.transition(a.E, a.nu, a.mu, a.Q, a.KIc, te)
+        return vertices(a.E, a.nu, a.mu, a.Q, a.KIc, te)[compare]
     # The crack's tip leads the fluid front by the dry zone the discretization
     # leaves (up to a cell); a zero-lag vertex has the two at one point, so the
     # front's error is printed too (column "front err").
@@ -152,7 +173,7 @@ def main():
         te = ti - a.t0
         if te <= 0 or compare is None or h["crack_length_m"][i] < 3 * L0:
             continue
-        ref = vertices(a.E, a.nu, a.mu, a.Q, a.KIc, te)[compare]
+        ref = reference(te)
         if compare == 2:  # Geertsma-de Klerk: (length, opening); no pressure
             ref = (ref[0], ref[1], float("nan"))
         sim = (h["crack_length_m"][i], h["mouth_opening_m"][i], h["inlet_pressure_pa"][i] - a.sigma0)
@@ -174,12 +195,15 @@ def main():
     fig, ax = plt.subplots(2, 2, figsize=(11, 8))
     tt = [x for x in t if x - a.t0 > 0]
     refs = [vertices(a.E, a.nu, a.mu, a.Q, a.KIc, x - a.t0) for x in tt]
+    trans = [kgd_transition.transition(a.E, a.nu, a.mu, a.Q, a.KIc, x - a.t0) for x in tt]
     ax[0, 0].plot(t, [1e3 * w for w in h["mouth_opening_m"]], "k.", ms=3, label="hfmpm")
     ax[0, 0].plot(tt, [1e3 * r[0][1] for r in refs], "b-", label="M-vertex")
     ax[0, 0].plot(tt, [1e3 * r[1][1] for r in refs], "r--", label="K-vertex")
     ax[0, 0].plot(tt, [1e3 * r[2][1] for r in refs], "g:", label="Geertsma-de Klerk (q = Q/2)")
+    ax[0, 0].plot(tt, [1e3 * r[1] for r in trans], "m-", lw=1, label=f"solution at Km = {kmv:.3g}")
     ax[0, 0].set(xlabel="t (s)", ylabel="mouth opening (mm)")
-    shown_w = [1e3 * r[vertex if vertex is not None else 0][1] for r in refs] + [1e3 * r[2][1] for r in refs]
+    shown_w = ([1e3 * r[vertex if vertex is not None else 0][1] for r in refs] + [1e3 * r[2][1] for r in refs]
+               + [1e3 * r[1] for r in trans])
     ax[0, 0].set_ylim(0, 1.3 * max([1e3 * w for w in h["mouth_opening_m"]] + shown_w))
     ax[0, 1].plot(t, h["crack_length_m"], "k.", ms=3, label="hfmpm (tip)")
     if front:
@@ -187,18 +211,21 @@ def main():
     ax[0, 1].plot(tt, [r[0][0] for r in refs], "b-", label="M-vertex")
     ax[0, 1].plot(tt, [r[1][0] for r in refs], "r--", label="K-vertex")
     ax[0, 1].plot(tt, [r[2][0] for r in refs], "g:", label="Geertsma-de Klerk")
+    ax[0, 1].plot(tt, [r[0] for r in trans], "m-", lw=1, label=f"solution at Km = {kmv:.3g}")
     ax[0, 1].set(xlabel="t (s)", ylabel="half-length (m)")
     # Scale to the run and the selected vertex (the other can be far off).
-    shown = [r[vertex if vertex is not None else 0][0] for r in refs] + [r[2][0] for r in refs]
+    shown = [r[vertex if vertex is not None else 0][0] for r in refs] + [r[2][0] for r in refs] + [r[0] for r in trans]
     ax[0, 1].set_ylim(0, 1.3 * max(h["crack_length_m"] + shown))
     ax[1, 0].plot(t, [1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"]], "k.", ms=3, label="hfmpm")
     ax[1, 0].plot(tt, [1e-3 * r[0][2] for r in refs], "b-", label="M-vertex")
     ax[1, 0].plot(tt, [1e-3 * r[1][2] for r in refs], "r--", label="K-vertex")
+    ax[1, 0].plot(tt, [1e-3 * r[2] for r in trans], "m-", lw=1, label=f"solution at Km = {kmv:.3g}")
     ax[1, 0].set(xlabel="t (s)", ylabel="net inlet pressure (kPa)")
     # Limits from the run and from the references after the first tenth of
     # the run (the M-vertex pressure diverges as t -> 0).
     net = [1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"]]
-    late = [1e-3 * r[v][2] for x, r in zip(tt, refs) for v in (0, 1) if x >= 0.1 * tt[-1]]
+    late = ([1e-3 * r[v][2] for x, r in zip(tt, refs) for v in (0, 1) if x >= 0.1 * tt[-1]]
+            + [1e-3 * r[2] for x, r in zip(tt, trans) if x >= 0.1 * tt[-1]])
     ax[1, 0].set_ylim(min(0.0, min(net)), 1.2 * max(net + late))
     try:
         import h5py
