@@ -91,12 +91,14 @@ class MpmSolidSide final : public coupling::SideModel {
     published_.resize(solver_->cracks().size(), 0);
     for (std::size_t c = 0; c < solver_->cracks().size(); ++c) {
       const auto& crack = solver_->cracks()[c];
+      // The implicit scheme's face response is over the coming step, which
+      // places the surfaces first (Solver::begin_step): the widths sent are those.
+      if (implicit_) solver_->begin_step();
       auto g = geometry(crack);
       // For a fluid's tip closure: E' where the crack ends, and the cell.
       g.tip_modulus = solver_->plane_strain_modulus_at(crack.plane().back());
       g.resolution = solver_->config().grid.h;
       if (implicit_) {  // the faces' response over the coming step, for the fluid's interface solve
-        solver_->begin_step();
         auto r = solver_->face_response(c);
         g.opening_rate = std::move(r.rate);
         g.opening_acceleration = std::move(r.acceleration);
@@ -299,6 +301,7 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   if (s.fracture().has_max_lag_cells()) c.fracture.max_lag_cells = s.fracture().max_lag_cells();
   c.fracture.settle_transits = s.fracture().settle_transits();
   c.fracture.front_settle_transits = s.fracture().front_settle_transits();
+  c.fracture.surfaces_from_material = s.fracture().surfaces_from_material();
   c.implicit_face_stiffness = s.implicit_face_stiffness();
   c.in_situ_reference = s.in_situ_reference();
   c.threads = static_cast<int>(s.threads());

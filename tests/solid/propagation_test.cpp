@@ -358,7 +358,7 @@ struct OpeningProfile {
   std::vector<double> x, surfaces, material;
 };
 
-OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows) {
+OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool from_material = false) {
   constexpr double kW = 1, kH = 1.5, kFinal = 0.4;
   const double sigma =
       0.5 * std::sqrt(kRock.plane_strain_modulus() * 500) / (tada_edge_factor(0.3 / kW) * std::sqrt(kPi * 0.3));
@@ -382,6 +382,7 @@ OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows) {
   config.fracture.max_lag_cells = 0;
   config.fracture.straight = true;
   config.fracture.growth_cells = 0.5;
+  config.fracture.surfaces_from_material = from_material;
   Solver solid(config);
   const double dt = solid.stable_dt();
   while (solid.time() < t_end) {
@@ -429,6 +430,38 @@ TEST(Propagation, DISABLED_GrownCrackOpensAsACrackCutAtThatLength) {
       if (tip - cut.x[k] < 1.5 * h - 1e-9) continue;  // the particle next to the tip
       EXPECT_NEAR(rm, 1, 0.02) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
       EXPECT_NEAR(rs, 1, 0.02) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
+    }
+  }
+}
+
+// The same comparison with the surfaces placed from the material at every
+// step (fracture.surfaces_from_material, Solver::anchor_crack_surfaces). On a
+// node row and between rows, every crack particle from 1.5 cells behind the
+// tip opens within 5% of the cut crack's (measured 4 December: between rows
+// 0.960, 0.966 at 2 and 1.5 cells, 0.973, 1.000 nearer the tip; on a node row
+// 1.0002-1.0007; the default velocity surfaces read 0.82, 0.81 and 0.84 there;
+// no contact acts in any of the four runs).
+// 5%: the surfaces can be no better than the material they are read from,
+// whose own grown/cut ratio between rows is 0.885 and 0.964 at those points
+// (the particles beside the grown faces keep part of the uncut body's strain,
+// the open item above), and the surfaces average it over a cell. More than a
+// cell behind the notch's tip (x <= 0.25: the crack cut from the start, out
+// of the tip cell's reach) the two cracks agree within 1% (measured 0.13%);
+// half a cell behind it 0.982. Every surface opening is positive and finite.
+TEST(Propagation, GrownCrackWithSurfacesFromTheMaterialOpensAsACutCrack) {
+  for (const bool between_rows : {true, false}) {
+    const auto cut = edge_crack_opening(0.4, false, between_rows, true);
+    const auto grown = edge_crack_opening(0.3, true, between_rows, true);
+    ASSERT_EQ(cut.x.size(), grown.x.size());
+    const double h = 1.0 / 20, tip = cut.x.back();
+    for (std::size_t k = 1; k + 1 < cut.x.size(); ++k) {
+      const double rs = grown.surfaces[k] / cut.surfaces[k];
+      std::printf("%s x %.4f grown/cut surfaces %.4f material %.4f\n", between_rows ? "between rows" : "on a row",
+                  cut.x[k], rs, grown.material[k] / cut.material[k]);
+      ASSERT_TRUE(std::isfinite(rs) && grown.surfaces[k] > 0) << "x = " << cut.x[k];
+      if (tip - cut.x[k] < 1.5 * h - 1e-9) continue;  // the particle next to the tip
+      EXPECT_NEAR(rs, 1, cut.x[k] < 0.3 - h + 1e-9 ? 0.01 : 0.05)
+          << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
     }
   }
 }

@@ -273,6 +273,7 @@ TEST(Versions, SceneSchemaIsBumpedWithTheSchema) {
       {2, 14058848928991701327ull},  // output.checkpoint_interval_s
       {3, 17634283515390672675ull},  // fracture.front_settle_transits
       {4, 1513303805568776259ull},   // fluid lag TIP_ASYMPTOTE
+      {5, 9617441847628438774ull},   // fracture.surfaces_from_material
   };
   ASSERT_TRUE(fingerprints.count(hfmpm::proto::kSceneSchemaVersion))
       << "no fingerprint recorded for scene schema version " << hfmpm::proto::kSceneSchemaVersion;

@@ -221,6 +221,7 @@ void Solver::begin_step() {
   } else {
     for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h, 1e-6 * config_.grid.h);
     p2g<true>();
+    if (config_.fracture.surfaces_from_material) anchor_crack_surfaces();
     contact(0.0);  // on the extrapolated momenta
     edge_loads();
     crack_loads(true, false);

@@ -220,6 +220,43 @@ void Solver::p2g_reduce(std::size_t k) {
   }
 }
 
+// Each near-crack particle's displacement taken to the nodes of its stencil
+// with its own gradient, u_p + grad u_p (x_i - x_p), mass-weighted into the
+// field P2G put it in at each node (stencil_fields_): affine_[f][i] / the
+// field's mass is the field's displacement at node i, exact for a linear
+// field whatever part of the stencil the field holds (a field across a crack
+// holds one particle row, whose mean displacement is a third of a cell off
+// the node). Every particle that reaches a node beside a crack is near it,
+// so those nodes' sums are whole. Serial: only the particles near a crack
+// scatter (a few hundred in the KGD scenes). For anchor_crack_surfaces.
+void Solver::affine_displacement() {
+  const Grid g = config_.grid;
+  for (int f = 0; f < 2; ++f) {
+    auto& a = affine_[static_cast<std::size_t>(f)];
+    if (a.size() != field0_.mass.size()) a.assign(field0_.mass.size(), Vec2::Zero());
+  }
+  for (const std::size_t n : affine_touched_) affine_[0][n] = affine_[1][n] = Vec2::Zero();
+  affine_touched_.clear();
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const std::uint16_t sides = stencil_fields_[p];
+    if (!(sides & (1u << 15))) continue;  // not near a crack
+    const Vec2 x = particles_.x[p];
+    const Vec2 rel = x - g.origin;
+    const StencilScale scale(g.h, particles_.half_size[p]);
+    const auto sx = ugimp_stencil(rel.x(), scale);
+    const auto sy = ugimp_stencil(rel.y(), scale);
+    const double m = particles_.mass[p];
+    const Vec2 u = particles_.displacement[p];
+    const Eigen::Matrix2d& grad = particles_.grad_u[p];
+    for_stencil<true>(g, sx, sy, [&](int b, int a, std::size_t n, double w, double, double) {
+      const int field = (sides >> (3 * b + a)) & 1;
+      Vec2& to = affine_[static_cast<std::size_t>(field)][n];
+      if (to.isZero() && affine_[static_cast<std::size_t>(1 - field)][n].isZero()) affine_touched_.push_back(n);
+      to += w * m * (u + grad * (g.position(static_cast<int>(n)) - x));
+    });
+  }
+}
+
 // The grid and the arrays through locals, as in p2g_scatter.
 template <bool kCracks>
 void Solver::g2p(double dt) {

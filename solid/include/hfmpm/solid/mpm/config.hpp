@@ -96,6 +96,11 @@ struct Fracture {
   // its direction are read on the field the front's pressure has made.
   // 0: grows at the first check.
   double front_settle_transits = 4;
+  // At the start of every step, set the crack surfaces about the plane with
+  // the material's opening, the jump of its displacement across the crack
+  // (Solver::anchor_crack_surfaces); false: the surfaces only integrate
+  // their fields' velocities.
+  bool surfaces_from_material = false;
 };
 
 struct SolidConfig {

@@ -198,6 +198,8 @@ class Solver {
   void spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force);
   void implicit_face_stiffness(double dt);
   void keep_fixed(std::size_t u, int f);
+  void affine_displacement();
+  void anchor_crack_surfaces();
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
@@ -255,6 +257,10 @@ class Solver {
   // Per particle, cracks only, set by P2G for G2P: bit 15 = near a crack,
   // bit 3 b + a = node (a, b) of its 3 x 3 stencil is in field 1.
   std::vector<std::uint16_t> stencil_fields_;
+  // Per field and node: sum of S m (u + grad u (x_i - x_p)) over the particles
+  // near a crack (affine_displacement), and the nodes it wrote.
+  std::array<std::vector<Vec2>, 2> affine_;
+  std::vector<std::size_t> affine_touched_;
   // The P2G (its serial number, transfer_) that last gave each node mass: a
   // node whose touched_in_ differs from transfer_ is empty this step.
   std::vector<std::uint32_t> touched_in_;
