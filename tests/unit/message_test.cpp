@@ -269,7 +269,7 @@ TEST(Versions, SceneSchemaIsBumpedWithTheSchema) {
   std::uint64_t hash = 1469598103934665603ull;
   for (unsigned char c : schema) hash = (hash ^ c) * 1099511628211ull;
   const std::map<std::uint32_t, std::uint64_t> fingerprints{
-      {1, 9993337185708650126ull},
+      {1, 9993337185708650126ull},   // the first
       {2, 14058848928991701327ull},  // output.checkpoint_interval_s
       {3, 17634283515390672675ull},  // fracture.front_settle_transits
       {4, 1513303805568776259ull},   // fluid lag TIP_ASYMPTOTE
