@@ -98,6 +98,9 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("interface.merges", interface_merges_);
   out.put("interface.newton", interface_newton_);
   out.put("interface.unconverged", interface_unconverged_);
+  out.put("interface.rescued", interface_rescued_);
+  out.put("interface.subcycled", interface_subcycled_);
+  out.put("interface.max_substeps", interface_max_substeps_);
 }
 
 void FluidSolver::load(const StateReader& in) {
@@ -171,6 +174,9 @@ void FluidSolver::load(const StateReader& in) {
   in.get("interface.merges", interface_merges_);
   in.get("interface.newton", interface_newton_);
   in.get("interface.unconverged", interface_unconverged_);
+  in.get("interface.rescued", interface_rescued_);
+  in.get("interface.subcycled", interface_subcycled_);
+  in.get("interface.max_substeps", interface_max_substeps_);
 }
 
 }  // namespace hfmpm::fluid::mpm
