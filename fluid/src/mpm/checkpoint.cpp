@@ -101,6 +101,7 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("interface.rescued", interface_rescued_);
   out.put("interface.subcycled", interface_subcycled_);
   out.put("interface.max_substeps", interface_max_substeps_);
+  out.put("interface.committed_above", interface_committed_above_);
 }
 
 void FluidSolver::load(const StateReader& in) {
@@ -177,6 +178,7 @@ void FluidSolver::load(const StateReader& in) {
   in.get("interface.rescued", interface_rescued_);
   in.get("interface.subcycled", interface_subcycled_);
   in.get("interface.max_substeps", interface_max_substeps_);
+  in.get("interface.committed_above", interface_committed_above_);
 }
 
 }  // namespace hfmpm::fluid::mpm

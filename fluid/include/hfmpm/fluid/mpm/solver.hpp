@@ -110,14 +110,14 @@ class FluidSolver {
   // colouring). The fluid then moves under P, and the nodal pressures it
   // reports are the ones the faces must carry over the same step. Needs the
   // solid's response with the last set_crack(); throws std::logic_error
-  // without it. A step whose solve fails (Newton's method ends above its
-  // tolerance and a volume strain of 1e-8, or every start turns a particle inside out) is not committed:
-  // it is taken again in 2, 4, ... kMaxSubsteps fluid substeps, each solved
-  // against the faces' response at its end (the opening interpolated
-  // linearly over the step, as if its pressure held all step); the last
-  // substep ends at dt, where the response is the solid's own. Throws
-  // std::runtime_error, naming the element or particle and why, if that
-  // fails too.
+  // without it. A step whose solve fails (Newton's method ends with an
+  // element misfit |Phi_e| V0_e above 1e-8 of the crack's fluid, or every
+  // start turns a particle inside out) is not committed: it is taken again in 2, 4, ... kMaxSubsteps fluid substeps,
+  // each solved against the faces' response at its end (the opening interpolated linearly over the step, as if its
+  // pressure held all step); the last substep ends at dt, where the response is the solid's own. If that fails too, a
+  // step whose solve ended above the bound is taken whole at its best iterate and reported
+  // (interface_committed_above_bound); one that turns a particle inside out throws std::runtime_error naming the
+  // particle and why.
   void step_implicit(double dt);
   // Implicit interface: Pa, the largest difference at a wetted node between
   // the pressure the faces carried over the last step and the fluid's
@@ -127,8 +127,8 @@ class FluidSolver {
   double interface_residual() const { return interface_residual_; }
   int interface_iterations() const { return interface_iterations_; }
   // Over the run: Newton iterations, solves that stopped above the tolerance
-  // (committed within a volume strain of 1e-8, else retried in fluid
-  // substeps), particles merged before a step.
+  // (committed if no element misfit exceeds 1e-8 of the crack's fluid,
+  // else retried in fluid substeps), particles merged before a step.
   std::uint64_t interface_newton_total() const { return interface_newton_; }
   std::uint64_t interface_unconverged_steps() const { return interface_unconverged_; }
   std::uint64_t interface_merges() const { return interface_merges_; }
@@ -138,6 +138,10 @@ class FluidSolver {
   std::uint64_t interface_rescued() const { return interface_rescued_; }
   std::uint64_t interface_subcycled_steps() const { return interface_subcycled_; }
   std::uint64_t interface_max_substeps() const { return interface_max_substeps_; }
+  // Steps that no number of substeps up to kMaxSubsteps solved within the
+  // bound and that were taken whole at their best iterate (reported).
+  std::uint64_t interface_committed_above_bound() const { return interface_committed_above_; }
+  bool interface_last_above_bound() const { return interface_above_bound_; }
   // The last step: its fluid substeps (1: taken whole), and why the whole
   // step failed when it was subcycled ("" otherwise).
   int interface_substeps() const { return interface_substeps_; }
@@ -275,8 +279,10 @@ class FluidSolver {
   std::uint64_t interface_rescued_ = 0;      // solves the careful Jacobian finished
   std::uint64_t interface_subcycled_ = 0;    // steps taken in fluid substeps
   std::uint64_t interface_max_substeps_ = 1;
-  int interface_substeps_ = 1;       // the last step's
-  std::string interface_retry_why_;  // why the last step was subcycled
+  std::uint64_t interface_committed_above_ = 0;  // steps taken whole above the bound after every retry
+  bool interface_above_bound_ = false;           // the last step was
+  int interface_substeps_ = 1;                   // the last step's
+  std::string interface_retry_why_;              // why the last step was subcycled
   // The step step_implicit is taking: the crack and its nodes at its start,
   // its length, and the end of the substep being solved (empty / 0 outside).
   std::vector<double> wall_start_;
