@@ -54,7 +54,7 @@ const coupling::SceneRules& rules() {
 // implicit step was committed 2e-7 under-filled, a kick that grew the notch
 // by a quarter cell before 0.25 s; since such a step is retried in
 // substeps, the crack first grows between 0.5 and 0.75 s, and from 0.75 s
-// on its length is the old run's to 1e-5 m.)
+// to 1.25 s its length is the old run's to 2e-6 m.)
 scene::Scene small_kgd() {
   return coupling::load_scene(
       source("scenarios/kgd-viscosity-ci.scene"), rules(),
