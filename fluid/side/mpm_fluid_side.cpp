@@ -94,7 +94,25 @@ class MpmFluidSide final : public coupling::SideModel {
   }
 
   void advance(double dt) override {
-    for (auto& c : cracks_) substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
+    for (auto& c : cracks_) {
+      substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
+      // An implicit step whose solve failed whole was taken in fluid
+      // substeps (FluidSolver::step_implicit): say so, the first
+      // kReportedRetries times (fluid.log; the count is in the summary).
+      if (config_.implicit_interface && c.solver.interface_last_above_bound() && above_reported_++ < kReportedRetries) {
+        std::fprintf(stderr,
+                     "hfmpm-fluid: crack %u: t = %.9g s: the implicit step of %.6g s was not solved within the bound, "
+                     "whole nor in up to %d fluid substeps; taken whole at its best iterate: %s%s\n",
+                     c.id, c.solver.time(), dt, mpm::FluidSolver::kMaxSubsteps, c.solver.interface_retry_why().c_str(),
+                     above_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
+      }
+      if (config_.implicit_interface && c.solver.interface_substeps() > 1 && retries_reported_++ < kReportedRetries) {
+        std::fprintf(
+            stderr, "hfmpm-fluid: crack %u: t = %.9g s: the implicit step of %.6g s taken in %d fluid substeps: %s%s\n",
+            c.id, c.solver.time(), dt, c.solver.interface_substeps(), c.solver.interface_retry_why().c_str(),
+            retries_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
+      }
+    }
     ++steps_;
   }
 
@@ -152,12 +170,18 @@ class MpmFluidSide final : public coupling::SideModel {
       const auto& s = c.solver;
       if (!config_.implicit_interface || s.steps() == 0) continue;
       std::fprintf(stderr,
-                   "hfmpm-fluid: crack %u: %llu implicit steps, %.2f Newton iterations per step, %llu stopped above "
-                   "tolerance, %llu particles merged before a step\n",
+                   "hfmpm-fluid: crack %u: %llu implicit steps, %.2f Newton iterations per step, %llu particles "
+                   "merged before a step; %llu solves finished by the careful Jacobian, %llu stopped above "
+                   "tolerance (committed if no element misfit exceeds 1e-8 of the fluid, else retried): %llu steps "
+                   "taken in fluid substeps (at most %llu), %llu taken whole above the bound after every retry\n",
                    c.id, static_cast<unsigned long long>(s.steps()),
                    static_cast<double>(s.interface_newton_total()) / static_cast<double>(s.steps()),
+                   static_cast<unsigned long long>(s.interface_merges()),
+                   static_cast<unsigned long long>(s.interface_rescued()),
                    static_cast<unsigned long long>(s.interface_unconverged_steps()),
-                   static_cast<unsigned long long>(s.interface_merges()));
+                   static_cast<unsigned long long>(s.interface_subcycled_steps()),
+                   static_cast<unsigned long long>(s.interface_max_substeps()),
+                   static_cast<unsigned long long>(s.interface_committed_above_bound()));
     }
   }
 
@@ -231,7 +255,9 @@ class MpmFluidSide final : public coupling::SideModel {
   std::vector<FluidCrack> cracks_;
   bool received_ = false;
   std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
-  output::SideFrames frames_;               // the frame file (solid.h5 / fluid.h5) across restarts
+  static constexpr int kReportedRetries = 20;
+  int retries_reported_ = 0, above_reported_ = 0;  // subcycled implicit steps written to the log (not checkpointed)
+  output::SideFrames frames_;                      // the frame file (solid.h5 / fluid.h5) across restarts
 };
 
 }  // namespace

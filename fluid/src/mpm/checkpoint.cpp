@@ -98,6 +98,10 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("interface.merges", interface_merges_);
   out.put("interface.newton", interface_newton_);
   out.put("interface.unconverged", interface_unconverged_);
+  out.put("interface.rescued", interface_rescued_);
+  out.put("interface.subcycled", interface_subcycled_);
+  out.put("interface.max_substeps", interface_max_substeps_);
+  out.put("interface.committed_above", interface_committed_above_);
 }
 
 void FluidSolver::load(const StateReader& in) {
@@ -171,6 +175,10 @@ void FluidSolver::load(const StateReader& in) {
   in.get("interface.merges", interface_merges_);
   in.get("interface.newton", interface_newton_);
   in.get("interface.unconverged", interface_unconverged_);
+  in.get("interface.rescued", interface_rescued_);
+  in.get("interface.subcycled", interface_subcycled_);
+  in.get("interface.max_substeps", interface_max_substeps_);
+  in.get("interface.committed_above", interface_committed_above_);
 }
 
 }  // namespace hfmpm::fluid::mpm

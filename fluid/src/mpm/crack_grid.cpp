@@ -70,6 +70,26 @@ void CrackGrid::set(const CrackGeometry& crack, double pre_opening, double pre_o
   min_spacing_ = min_spacing;
 }
 
+void CrackGrid::move(const std::vector<Vec2>& position, const std::vector<double>& crack_width) {
+  const std::size_t n = ids_.size();
+  if (position.size() != n || crack_width.size() != n) {
+    reject(crack_id_, "move: positions and widths must have one entry per node (" + std::to_string(n) + ")");
+  }
+  std::vector<double> arc = arc_length(position);
+  double min_spacing = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < n; ++i) {
+    const double h = arc[i] - arc[i - 1];
+    if (!(h > 0) || !std::isfinite(h))
+      reject(crack_id_, "move: nodes " + std::to_string(i - 1) + " and " + std::to_string(i) + " would coincide");
+    min_spacing = std::min(min_spacing, h);
+  }
+  for (std::size_t i = 0; i < n; ++i) width_[i] = crack_width[i] + (width_[i] - crack_width_[i]);
+  crack_width_ = crack_width;
+  position_ = position;
+  arc_ = std::move(arc);
+  min_spacing_ = min_spacing;
+}
+
 double CrackGrid::width_integral(double a, double b) const { return integrate(arc_, width_, a, b); }
 
 double CrackGrid::interpolate(double s, std::span<const double> values) const {

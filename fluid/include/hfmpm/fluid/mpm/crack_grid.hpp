@@ -35,6 +35,12 @@ class CrackGrid {
   // Every node is virtual_opening (m) wider still.
   void set(const CrackGeometry& crack, double pre_opening, double pre_opening_length, double virtual_opening = 0);
 
+  // Move the nodes within a step (the implicit step's fluid substeps): new
+  // positions and crack widths for the same nodes; each node keeps its
+  // virtual and pre-opening. The positions must keep the nodes distinct
+  // (std::invalid_argument otherwise).
+  void move(const std::vector<Vec2>& position, const std::vector<double>& crack_width);
+
   bool empty() const { return ids_.empty(); }
   std::size_t size() const { return ids_.size(); }
   std::uint32_t crack_id() const { return crack_id_; }

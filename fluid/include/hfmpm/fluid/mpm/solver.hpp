@@ -58,6 +58,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -109,7 +110,14 @@ class FluidSolver {
   // colouring). The fluid then moves under P, and the nodal pressures it
   // reports are the ones the faces must carry over the same step. Needs the
   // solid's response with the last set_crack(); throws std::logic_error
-  // without it, std::runtime_error if the step inverts a particle.
+  // without it. A step whose solve fails (Newton's method ends with an
+  // element misfit |Phi_e| V0_e above 1e-8 of the crack's fluid, or every
+  // start turns a particle inside out) is not committed: it is taken again in 2, 4, ... kMaxSubsteps fluid substeps,
+  // each solved against the faces' response at its end (the opening interpolated linearly over the step, as if its
+  // pressure held all step); the last substep ends at dt, where the response is the solid's own. If that fails too, a
+  // step whose solve ended above the bound is taken whole at its best iterate and reported
+  // (interface_committed_above_bound); one that turns a particle inside out throws std::runtime_error naming the
+  // particle and why.
   void step_implicit(double dt);
   // Implicit interface: Pa, the largest difference at a wetted node between
   // the pressure the faces carried over the last step and the fluid's
@@ -118,11 +126,29 @@ class FluidSolver {
   double interface_mismatch() const { return interface_mismatch_; }
   double interface_residual() const { return interface_residual_; }
   int interface_iterations() const { return interface_iterations_; }
-  // Over the run: Newton iterations, steps that stopped above the tolerance
-  // (their best iterate was taken), particles merged before a step.
+  // Over the run: Newton iterations, solves that stopped above the tolerance
+  // (committed if no element misfit exceeds 1e-8 of the crack's fluid,
+  // else retried in fluid substeps), particles merged before a step.
   std::uint64_t interface_newton_total() const { return interface_newton_; }
   std::uint64_t interface_unconverged_steps() const { return interface_unconverged_; }
   std::uint64_t interface_merges() const { return interface_merges_; }
+  // Solves that the forward-difference Jacobian left above the tolerance and
+  // the careful one finished (implicit.cpp); steps taken in more than one
+  // fluid substep, and the most substeps one step took.
+  std::uint64_t interface_rescued() const { return interface_rescued_; }
+  std::uint64_t interface_subcycled_steps() const { return interface_subcycled_; }
+  std::uint64_t interface_max_substeps() const { return interface_max_substeps_; }
+  // Steps that no number of substeps up to kMaxSubsteps solved within the
+  // bound and that were taken whole at their best iterate (reported).
+  std::uint64_t interface_committed_above_bound() const { return interface_committed_above_; }
+  bool interface_last_above_bound() const { return interface_above_bound_; }
+  // The last step: its fluid substeps (1: taken whole), and why the whole
+  // step failed when it was subcycled ("" otherwise).
+  int interface_substeps() const { return interface_substeps_; }
+  const std::string& interface_retry_why() const { return interface_retry_why_; }
+  // The most fluid substeps step_implicit tries (doubling from 1) before it
+  // stops the run.
+  static constexpr int kMaxSubsteps = 256;
 
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
@@ -206,12 +232,17 @@ class FluidSolver {
   void project_pressure(const std::vector<double>& pp, std::vector<double>& nodal, std::vector<double>& scratch) const;
   // implicit.cpp
   struct Trial {
-    std::vector<double> pp, nodal, scratch, force, v, width, a, b, mass, volume, volume0;
+    std::vector<double> pp, nodal, scratch, force, v, width, opened, a, b, mass, volume, volume0;
     std::ptrdiff_t squeezed = -1;  // a particle the step turned inside out (the trial failed), or -1
     const char* why = "";          // what failed the trial, for the error message
   };
   // Residual P_e - p_Tait(V_e / V0_e) of element pressures P after a trial step of dt.
   bool interface_trial(const std::vector<double>& P, double dt, Trial& t, std::vector<double>& residual) const;
+  // One fluid substep of h ending at tau within the step step_implicit
+  // takes (last: it ends the step); returns the nodal pressures the faces
+  // carry. Throws StepFailed (implicit.cpp) without committing anything if
+  // the solve fails.
+  std::vector<double> implicit_substep(double h, double tau, bool last);
   void pressure_force(const std::vector<double>& pp, double mouth, std::vector<double>& force) const;
   // The push of front_counter_pressure() back on the front end (a no-op when it is 0).
   void front_force(std::vector<double>& force) const;
@@ -244,7 +275,19 @@ class FluidSolver {
   int interface_iterations_ = 0;
   std::uint64_t interface_merges_ = 0;       // particles merged because a step would have squeezed them
   std::uint64_t interface_newton_ = 0;       // Newton iterations over the run
-  std::uint64_t interface_unconverged_ = 0;  // steps whose solve stopped above its tolerance
+  std::uint64_t interface_unconverged_ = 0;  // solves that stopped above their tolerance
+  std::uint64_t interface_rescued_ = 0;      // solves the careful Jacobian finished
+  std::uint64_t interface_subcycled_ = 0;    // steps taken in fluid substeps
+  std::uint64_t interface_max_substeps_ = 1;
+  std::uint64_t interface_committed_above_ = 0;  // steps taken whole above the bound after every retry
+  bool interface_above_bound_ = false;           // the last step was
+  int interface_substeps_ = 1;                   // the last step's
+  std::string interface_retry_why_;              // why the last step was subcycled
+  // The step step_implicit is taking: the crack and its nodes at its start,
+  // its length, and the end of the substep being solved (empty / 0 outside).
+  std::vector<double> wall_start_;
+  std::vector<Vec2> wall_start_position_;
+  double wall_dt_ = 0, wall_tau_ = 0;
 };
 
 }  // namespace hfmpm::fluid::mpm
