@@ -240,7 +240,7 @@ class FluidSolver {
   bool interface_trial(const std::vector<double>& P, double dt, Trial& t, std::vector<double>& residual) const;
   // One fluid substep of h ending at tau within the step step_implicit
   // takes (last: it ends the step); returns the nodal pressures the faces
-  // carry. Throws StepFailed (implicit.cpp) without committing anything if
+  // carry. Throws StepFailed (implicit_detail.hpp) without committing anything if
   // the solve fails.
   std::vector<double> implicit_substep(double h, double tau, bool last);
   void pressure_force(const std::vector<double>& pp, double mouth, std::vector<double>& force) const;

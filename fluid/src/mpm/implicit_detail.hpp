@@ -1,0 +1,54 @@
+// Internal to the implicit interface step (implicit.cpp, implicit_substep.cpp):
+// the failures a (sub)step throws, the colouring of the difference Jacobian,
+// and two small helpers.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "hfmpm/fluid/mpm/shape.hpp"
+
+namespace hfmpm::fluid::mpm::implicit_detail {
+
+struct Squeezed {
+  std::ptrdiff_t particle;
+};
+
+// A (sub)step whose interface solve failed: not committed; step_implicit
+// retries the step in more fluid substeps.
+struct StepFailed {
+  std::string message;
+  bool misfit = false;  // Newton's method ended above the bound (not: a particle turned inside out)
+};
+
+// Elements perturbed together when the Jacobian is built by differences: a
+// pressure reaches the residuals of elements at most kReach away (a particle
+// spans up to ~2 elements; its ends move with the nodes around it; the faces
+// open under the pressure projected to the nodes it touches).
+constexpr std::size_t kReach = 5;
+constexpr std::size_t kColours = 2 * kReach + 1;
+
+// The element pieces of a domain [a, b]: fn(element, fraction of the length).
+template <class Fn>
+void for_pieces(const std::vector<double>& arc, double a, double b, Fn&& fn) {
+  const std::size_t elements = arc.size() - 1;
+  const double l = b - a;
+  if (!(l > 0)) return;
+  const std::size_t first = hat_at(arc, a).node, last = hat_at(arc, b).node;
+  for (std::size_t e = first; e <= last && e < elements; ++e) {
+    const double lo = e == 0 ? a : std::max(a, arc[e]);
+    const double hi = e + 1 == elements ? b : std::min(b, arc[e + 1]);
+    if (hi > lo) fn(e, (hi - lo) / l);
+  }
+}
+
+inline double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+}  // namespace hfmpm::fluid::mpm::implicit_detail
