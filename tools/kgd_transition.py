@@ -5,6 +5,7 @@
     /usr/bin/python3 tools/kgd_transition.py --convergence        # the limits and the refinement study
     /usr/bin/python3 tools/kgd_transition.py --make-table         # rewrites tools/kgd_transition.csv
     /usr/bin/python3 tools/kgd_transition.py --self-test          # ctest unit.KgdTransition.LimitsAndConvergence
+    /usr/bin/python3 tools/kgd_transition.py --tip-closure        # the fluid's tip closure against the M-vertex
 
     import kgd_transition; kgd_transition.transition(E, nu, mu, Q, KIc, t)
         -> (half_length, mouth_opening, net_inlet_pressure), the layout of each vertex of
@@ -744,6 +745,38 @@ def report_km(km, rhos):
     print(f"{'M-vertex':>11} {M_VERTEX[0]:12.8f} {M_VERTEX[1]:12.8f} {M_VERTEX[2]:12.8f}   (kgd_plot.py)")
 
 
+def tip_closure(rho=16.0):
+    """The fluid's tip closure (docs/fluid.md) against the M-vertex's own pressure near its tip.
+
+    Near the tip the M-vertex's net pressure is Pi = -C s^(-1/3) + B + ..., s = 1 - xi,
+    C = (3 / beta_m^2) (2/3)^(1/3) (the tip solution in these scales, V = (2/3) l / t). The
+    closure with the confining stress as the level (net 0, lag TIP_ASYMPTOTE) gives
+    -C d^(-1/3); matched to the pressure at s_m = s_f + d it gives Pi(s_m) - C (s_f^(-1/3) -
+    s_m^(-1/3)); matched as lag TIP_ASYMPTOTE_MATCHED does, to the mean of Pi + C s^(-1/3) from
+    2 to 4 cells behind the front, level - C s_f^(-1/3). Against Pi(s_f), in units of Pi(0), for
+    fronts s_f and cells d as fractions of the half-length.
+    """
+    np = _np()
+    (g, o0, p0), sv = solve(0.0, rho)
+    xi, om, p = sv.profile()
+    s = 1 - xi[:len(p)]
+    order = np.argsort(s)
+    s, p = s[order], p[order]
+    C = 3 / (2 ** (2 / 3) * 3 ** (5 / 3)) * (2 / 3) ** (1 / 3)
+    at = lambda x: float(np.interp(x, s, p))
+    print(f"M-vertex Pi(0) = {p0:.4f}; C = {C:.4f}; B = Pi + C s^(-1/3) at s = 1e-3, 1e-2, 5e-2: "
+          + ", ".join(f"{(at(x) + C * x ** (-1 / 3)) / p0:.3f}" for x in (1e-3, 1e-2, 5e-2)) + " Pi(0)")
+    print(f"{'d/l':>6} {'s_f/l':>6} {'Pi(s_f)':>9} {'level 0':>9} {'1 cell':>9} {'2-4 cells':>9}   (all / Pi(0))")
+    for d in (0.03, 0.058, 0.1):
+        for sf in (0.25 * d, 0.5 * d, d):
+            old = -C * d ** (-1 / 3)
+            one = at(sf + d) - C * (sf ** (-1 / 3) - (sf + d) ** (-1 / 3))
+            window = [sf + d * (2 + 2 * k / 20) for k in range(21)]  # the fluid's pressures 2 to 4 cells behind
+            level = sum(at(x) + C * x ** (-1 / 3) for x in window) / len(window)
+            matched = level - C * sf ** (-1 / 3)
+            print(f"{d:6.3f} {sf:6.3f} {at(sf) / p0:9.3f} {old / p0:9.3f} {one / p0:9.3f} {matched / p0:9.3f}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--km", type=float, help="solve at this Km and print the refinement")
@@ -752,6 +785,8 @@ def main():
                     help=f"rewrite {os.path.relpath(TABLE, os.path.dirname(HERE))}")
     ap.add_argument("--convergence", action="store_true", help="the limits, the refinement study and the cross-checks")
     ap.add_argument("--self-test", action="store_true", help="the ctest check (limits, order, table)")
+    ap.add_argument("--tip-closure", action="store_true",
+                    help="the fluid's tip closure against the M-vertex's pressure near its tip")
     a = ap.parse_args()
     if a.make_table:
         make_table()
@@ -761,6 +796,8 @@ def main():
         convergence()
     elif a.self_test:
         sys.exit(self_test())
+    elif a.tip_closure:
+        tip_closure()
     else:
         ap.print_help()
 

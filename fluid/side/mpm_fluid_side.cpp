@@ -289,8 +289,10 @@ mpm::FluidConfig to_fluid_config(const scene::Scene& scene) {
   c.virtual_opening = f.virtual_opening_m();
   c.lag = f.lag() == scene::MpmFluid::FRONT_PRESSURE   ? mpm::FluidConfig::Lag::Front
           : f.lag() == scene::MpmFluid::FIXED_PRESSURE ? mpm::FluidConfig::Lag::Fixed
-          : f.lag() == scene::MpmFluid::TIP_ASYMPTOTE  ? mpm::FluidConfig::Lag::TipAsymptote
-                                                       : mpm::FluidConfig::Lag::Zero;
+          : f.lag() == scene::MpmFluid::TIP_ASYMPTOTE || f.lag() == scene::MpmFluid::TIP_ASYMPTOTE_MATCHED
+              ? mpm::FluidConfig::Lag::TipAsymptote
+              : mpm::FluidConfig::Lag::Zero;
+  c.tip_level_matched = f.lag() == scene::MpmFluid::TIP_ASYMPTOTE_MATCHED;
   c.lag_pressure = f.lag_pressure_pa();
   if (f.has_outlet()) {
     c.outlet.enabled = true;

@@ -219,7 +219,7 @@ TEST(FluidScene, BadFluidSettingsAreRefused) {
       {"fluid.mpm.inlet.pressure_pa.constant=-1", "fluid.mpm.inlet.pressure_pa.constant", ">= 0"},
       {"fluid.mpm.virtual_opening_m=-1e-5", "fluid.mpm.virtual_opening_m", ">= 0"},
       {"fluid.mpm.lag=LAG_UNSPECIFIED", "fluid.mpm.lag",
-       "ZERO_PRESSURE, FRONT_PRESSURE, FIXED_PRESSURE or TIP_ASYMPTOTE"},
+       "ZERO_PRESSURE, FRONT_PRESSURE, FIXED_PRESSURE, TIP_ASYMPTOTE or TIP_ASYMPTOTE_MATCHED"},
       {"fluid.mpm.lag_pressure_pa=-1", "fluid.mpm.lag_pressure_pa", ">= 0"},
       {"fluid.mpm.merge_fraction=2", "fluid.mpm.merge_fraction", ">= 0 and < 2"},
       {"fluid.mpm.initial_fill.pressure_pa=3e9", "fluid.mpm.initial_fill.pressure_pa", "bulk_modulus_pa"},

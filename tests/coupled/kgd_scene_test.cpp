@@ -134,9 +134,13 @@ TEST(KgdScene, KVertexReference) {
 // half the ramp). Also: the injected volume is the integral of the ramp; the
 // fluid's volume is its zero-pressure volume less a compression of at most
 // the Tait J at the run's highest inlet pressure; the run stays quasi-static.
+struct Bounds {
+  double length = 0.10, opening = 0.10, pressure = 0.20;  // the CI-size bounds
+};
+
 template <class Reference>
 void expect_ci_scene_follows(const std::string& scene, double Q, Reference reference, double bulk_modulus = 2e6,
-                             std::vector<std::string> sets = {}) {
+                             std::vector<std::string> sets = {}, Bounds bounds = {}) {
   const auto out = scratch_dir("kgd_ci");
   std::vector<std::string> args{"--set", "output.hdf5=false"};
   args.insert(args.end(), sets.begin(), sets.end());
@@ -159,7 +163,11 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
     if (t[i] > 0.1) {
       EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
       const double ratio = volume[i] / (injected[i] + kInitial);
-      EXPECT_GT(ratio, j_min) << "t = " << t[i];
+      // Below the compression only by the implicit step's misfit at a row
+      // the tip grew in: the fluid's state is read at the crack the solid
+      // published, which growth changed within the step (measured 4.1e-5 at
+      // one row of the matched closure's run; water compresses 6e-5 here).
+      EXPECT_GT(ratio, j_min - 1e-4) << "t = " << t[i];
       // Above 1 only by a particle at zero pressure stretched past its rest
       // volume (J > 1: the liquid cavitates rather than carry tension), whose
       // domain then counts some empty crack: water's front particle early on
@@ -172,9 +180,9 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
     const double e_pressure = (p_in[i] - kSigma0) / v.pressure - 1;
     std::printf("t %.2f s: half-length %+.3f, mouth opening %+.3f, net inlet pressure %+.3f\n", t[i], e_length,
                 e_opening, e_pressure);
-    EXPECT_LT(std::abs(e_length), 0.10) << "t = " << t[i];
-    EXPECT_LT(std::abs(e_opening), 0.10) << "t = " << t[i];
-    EXPECT_LT(std::abs(e_pressure), 0.20) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_length), bounds.length) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_opening), bounds.opening) << "t = " << t[i];
+    EXPECT_LT(std::abs(e_pressure), bounds.pressure) << "t = " << t[i];
     worst_length = std::max(worst_length, std::abs(e_length));
     worst_opening = std::max(worst_opening, std::abs(e_opening));
     worst_pressure = std::max(worst_pressure, std::abs(e_pressure));
@@ -194,6 +202,23 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
 TEST(KgdScene, ViscosityCiSceneFollowsTheMVertex) {
   expect_ci_scene_follows(
       "scenarios/kgd-viscosity-ci.scene", 2.5e-4, [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9);
+}
+
+// The same with the tip closure matched to the fluid (lag
+// TIP_ASYMPTOTE_MATCHED) and the crack's surfaces from the material, which it
+// needs (docs/fluid.md). Measured (4 December): 3.0%, 1.8% and 5.8% worst,
+// the fluid front within 2.7%; asserted within about twice that (6%, 4%,
+// 10%), tighter than the CI bounds, so that the closure's gain in length and
+// opening over the default (5.6%, 4.9%, 2.2%) stays held; a growth step is
+// 1.4-1.9% of the crack at the compared rows. The pressure is 4-6% low at
+// every row: the finite box makes the body 4-5% more compliant than the
+// M-vertex's infinite one (a net pressure 3% lower at the same injection),
+// and the virtual film eases the flow by (1 + f / w)^3 (docs/verification.md).
+TEST(KgdScene, ViscosityCiSceneWithTheMatchedClosureFollowsTheMVertex) {
+  expect_ci_scene_follows(
+      "scenarios/kgd-viscosity-ci.scene", 2.5e-4, [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9,
+      {"--set", "fluid.mpm.lag=TIP_ASYMPTOTE_MATCHED", "--set", "solid.mpm.fracture.surfaces_from_material=true"},
+      {0.06, 0.04, 0.10});
 }
 
 // Toughness-dominated (Km = 7.6) against the K-vertex, with water and the

@@ -1,7 +1,7 @@
 // The fluid front's closures (docs/fluid.md, "Forces and the step"): the
 // pressure the crack carries beyond the front for each lag rule, and the tip
-// closure (Lag::TipAsymptote) against the zero-toughness tip solution and the
-// front speed of a pressure-driven channel.
+// closure (Lag::TipAsymptote, and matched in level to the fluid) against the
+// zero-toughness tip solution and the front speed of a pressure-driven channel.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -114,6 +114,73 @@ TEST(FluidSolver, TipAsymptoteClosureIsTheTipSolutionsPressureOneCellBehind) {
   const double L_vacuum = 0.5 * (start + vacuum.front_position());
   EXPECT_NEAR((vacuum.front_position() - start) / 0.01, p_in * w * w / (12 * mu * L_vacuum),
               0.015 * p_in * w * w / (12 * mu * L_vacuum));
+}
+
+// The matched tip closure (lag TIP_ASYMPTOTE_MATCHED, FluidConfig::
+// tip_level_matched): near a tip p = p0 - A s^(-1/3), A from the tip solution
+// above, and the level p0 is matched to the fluid's pressures two to four
+// cells d behind the front, as the mean of p + A s^(-1/3) over its nodes
+// there (with the implicit interface step over the element pressures the
+// step solved): the front, s_f (at least d / 2) from the tip, meets
+// p0 - A s_f^(-1/3), at most the confining stress and at least 0. Checked
+// against that, computed here independently, in a channel of uniform width
+// whose closed end (the tip) is a cell ahead of the front, driven by a
+// pressure inlet a tenth above the confining stress; the front then runs at
+// the Poiseuille speed under the counter-pressure.
+TEST(FluidSolver, TipAsymptoteClosureMatchesTheTipSolutionToTheFluidBehindTheFront) {
+  const double E = 1e7, d = 0.05, mu = 1, w = 1e-3, p_in = 1.1e5, sigma = 1e5, tip = 0.55;
+  const double beta3 = 18 * std::sqrt(3.0);  // (beta / (mu' V / E')^(1/3))^3
+  FluidConfig c;
+  c.bulk_modulus = 2e9;
+  c.viscosity = mu;
+  c.inlet.kind = InletConfig::Kind::Pressure;
+  c.inlet.pressure = TimeFunction::constant(p_in);
+  c.lag = FluidConfig::Lag::TipAsymptote;
+  c.tip_level_matched = true;
+  c.lag_pressure = sigma;
+  FluidSolver fluid(c);
+  auto crack = test::channel(tip, 11, w);
+  EXPECT_THROW(fluid.set_crack(crack), std::invalid_argument);  // the solid sent no E' and cell
+  crack.tip_modulus = E;
+  crack.resolution = d;
+  fluid.set_crack(crack);
+  fluid.fill(0.5, p_in);
+  EXPECT_EQ(fluid.front_counter_pressure(), sigma);  // at rest: the confining stress
+  fluid.advance(0.04);                               // 27 diffusion times L^2 / (K w^2 / 12 mu) of the pressure: steady
+  const double front0 = fluid.front_position();
+  // The closure, computed here from the fluid's state.
+  const auto& P = fluid.particles();
+  double m = 0, mv = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (P.s[p] < front0 - d && p + 1 < P.size()) continue;
+    m += P.mass[p];
+    mv += P.mass[p] * P.velocity[p];
+  }
+  const double V = mv / m, beta = std::cbrt(beta3 * 12 * mu * V / E), A = 3 * 12 * mu * V / (beta * beta);
+  // The level p0: the mean of p_i + A (tip - s_i)^(-1/3) over the nodes two
+  // to four cells d behind the front (the nodes at 0.35 and 0.40 m here).
+  const auto& nodal = fluid.nodal_pressure();
+  const auto& arc = fluid.grid().arc();
+  double sum = 0;
+  int count = 0;
+  for (std::size_t i = 0; i < arc.size(); ++i) {
+    if (arc[i] < front0 - 4 * d || arc[i] > front0 - 2 * d) continue;
+    sum += nodal[i] + A / std::cbrt(tip - arc[i]);
+    ++count;
+  }
+  EXPECT_EQ(count, 2);
+  const double s_f = std::max(tip - front0, d / 2);
+  const double expected = std::clamp(sum / count - A / std::cbrt(s_f), 0.0, sigma);
+  const double counter = fluid.front_counter_pressure();
+  EXPECT_NEAR(counter, expected, 1e-6 * sigma);
+  EXPECT_LT(counter, sigma - 0.1 * (p_in - sigma));  // the tip solution acts (not the confining cap)
+  // The front runs at the Poiseuille speed under that counter-pressure, over
+  // the filled length (1.5%, as for the vacuum front above).
+  fluid.advance(0.01);
+  const double L = 0.5 * (front0 + fluid.front_position());
+  const double speed = (fluid.front_position() - front0) / 0.01, poiseuille = (p_in - counter) * w * w / (12 * mu * L);
+  EXPECT_NEAR(speed, poiseuille, 0.015 * poiseuille);
+  EXPECT_NEAR(V, speed, 0.015 * speed);  // and the fluid within d of the front moves with it
 }
 
 }  // namespace

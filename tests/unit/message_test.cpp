@@ -274,6 +274,7 @@ TEST(Versions, SceneSchemaIsBumpedWithTheSchema) {
       {3, 17634283515390672675ull},  // fracture.front_settle_transits
       {4, 1513303805568776259ull},   // fluid lag TIP_ASYMPTOTE
       {5, 9617441847628438774ull},   // fracture.surfaces_from_material
+      {6, 17530128371913356884ull},  // fluid lag TIP_ASYMPTOTE_MATCHED
   };
   ASSERT_TRUE(fingerprints.count(hfmpm::proto::kSceneSchemaVersion))
       << "no fingerprint recorded for scene schema version " << hfmpm::proto::kSceneSchemaVersion;

@@ -101,6 +101,12 @@ struct FluidConfig {
   enum class Lag { Zero, Front, Fixed, TipAsymptote };
   Lag lag = Lag::Zero;
   double lag_pressure = 0;  // Pa, for Lag::Fixed and Lag::TipAsymptote
+  // With Lag::TipAsymptote: the tip solution's level matched to the fluid
+  // (scene lag TIP_ASYMPTOTE_MATCHED; FluidSolver::front_counter_pressure):
+  // the front, s_f >= d/2 from the tip, meets p0 - A s_f^(-1/3), p0 the mean
+  // of p + A s^(-1/3) over the fluid's pressures 2 to 4 cells behind it,
+  // clamped to [0, lag_pressure]. False: p0 = lag_pressure and s_f = d.
+  bool tip_level_matched = false;
   double min_width = 1e-9;  // m, width floor in the drag and in w0 (numerical; the drag is implicit)
   InletConfig inlet;
   OutletConfig outlet;

@@ -183,6 +183,8 @@ class FluidSolver {
   // Pa, the pressure beyond the front that the fluid front pushes against:
   // 0 (a vacuum), or with Lag::TipAsymptote the tip solution's (config.hpp).
   double front_counter_pressure() const;
+  // m/s, the front's speed: the mass-weighted mean velocity of the fluid within the solid's cell of the front.
+  double front_speed() const;
   // Pa, the pressure held at the mouth: p_in(t), or for a flow-rate inlet
   // the inlet particle's pressure.
   double inlet_pressure() const;
