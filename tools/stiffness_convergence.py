@@ -2,10 +2,12 @@
 """The coupled KGD answer against the fluid's stiffness: one command, the table issue 17 asks.
 
     /usr/bin/python3 tools/stiffness_convergence.py [--out DIR] [--scenes S1,S2] [--moduli K1,K2] [--force]
+                                                    [--set KEY=VALUE ...]
 
 Runs each scene (default: kgd-viscosity-ci, kgd-toughness-ci, kgd-viscosity, kgd-toughness)
 as it is, with only fluid.mpm.bulk_modulus_pa set to each modulus (default 2e6, 2e7, 2e8,
-2e9 Pa): the scene's own scheme, step (chosen by the program) and closures. One run at a time.
+2e9 Pa): the scene's own scheme, step (chosen by the program) and closures; --set KEY=VALUE
+(repeatable) is passed to every run, e.g. another closure. One run at a time.
 For each run it prints whether it completed, its wall time and step count, and, against the
 same scene's water run (the last modulus), the worst row-by-row difference of half-length,
 mouth opening and net inlet pressure over the output rows once the crack is three notch
@@ -44,13 +46,15 @@ def completed(run):
         return False
 
 
-def run_one(scene, modulus, out, force):
+def run_one(scene, modulus, out, force, sets=()):
     run = os.path.join(out, scene, f"{modulus:g}")
     if completed(run) and not force:
         return run, None
     os.makedirs(os.path.dirname(run), exist_ok=True)
     cmd = [HFMPM, "run", os.path.join(ROOT, "scenarios", scene + ".scene"), "--out", run, "--quiet",
            "--set", f"fluid.mpm.bulk_modulus_pa={modulus:g}", "--set", "output.hdf5=false"]
+    for kv in sets:
+        cmd += ["--set", kv]
     start = time.time()
     result = subprocess.run(cmd, capture_output=True, text=True)
     if result.returncode != 0:
@@ -87,6 +91,8 @@ def main():
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--moduli", default=",".join(f"{k:g}" for k in MODULI))
     ap.add_argument("--force", action="store_true", help="run again runs that completed")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a scene setting for every run (repeatable)")
     a = ap.parse_args()
     moduli = [float(k) for k in a.moduli.split(",")]
     lines = ["| scene | K (Pa) | status | wall (s) | steps | half-length | mouth opening | net inlet pressure "
@@ -96,7 +102,7 @@ def main():
             sys.exit(f"stiffness_convergence: no scenarios/{scene}.scene")
         runs = {}
         for k in moduli:
-            runs[k] = run_one(scene, k, a.out, a.force)
+            runs[k] = run_one(scene, k, a.out, a.force, a.set)
         reference_run, reference_error = runs[moduli[-1]]
         for k in moduli:
             run, error = runs[k]
