@@ -65,8 +65,9 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
       s.solid().mpm().fracture().propagate() && !s.solid().mpm().fracture().surfaces_from_material()) {
     c.bad(key + "lag", "TIP_ASYMPTOTE_MATCHED",
           "with a growing MPM crack, TIP_ASYMPTOTE_MATCHED needs solid.mpm.fracture.surfaces_from_material: true (a "
-          "crack grown under load otherwise reads 0.65-0.82 of its opening, and the closure runs the crack 9% short "
-          "and 16% wide); or another lag: ZERO_PRESSURE, FRONT_PRESSURE, FIXED_PRESSURE or TIP_ASYMPTOTE");
+          "crack grown under load otherwise reads 0.65-0.82 of its opening, and the closure, matched to that "
+          "opening, runs the crack short and wide); or another lag: ZERO_PRESSURE, FRONT_PRESSURE, FIXED_PRESSURE or "
+          "TIP_ASYMPTOTE");
   }
   if (f.max_substeps() < 1 || f.max_substeps() > 100000) {
     c.bad(key + "max_substeps", std::to_string(f.max_substeps()), "1 to 100000 fluid steps per coupled step");
