@@ -136,6 +136,11 @@ TEST(KgdScene, KVertexReference) {
 // the Tait J at the run's highest inlet pressure; the run stays quasi-static.
 struct Bounds {
   double length = 0.10, opening = 0.10, pressure = 0.20;  // the CI-size bounds
+  // How far the fluid's volume may fall below its compressed zero-pressure
+  // volume: the implicit step's misfit at a row the tip grew in (the fluid's
+  // state is read at the crack the solid published, which growth changed
+  // within the step). 0 unless a run is measured to need it.
+  double volume_misfit = 0;
 };
 
 template <class Reference>
@@ -163,11 +168,7 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
     if (t[i] > 0.1) {
       EXPECT_LT(ke[i], 1e-2 * work) << "t = " << t[i];
       const double ratio = volume[i] / (injected[i] + kInitial);
-      // Below the compression only by the implicit step's misfit at a row
-      // the tip grew in: the fluid's state is read at the crack the solid
-      // published, which growth changed within the step (measured 4.1e-5 at
-      // one row of the matched closure's run; water compresses 6e-5 here).
-      EXPECT_GT(ratio, j_min - 1e-4) << "t = " << t[i];
+      EXPECT_GT(ratio, j_min - bounds.volume_misfit) << "t = " << t[i];
       // Above 1 only by a particle at zero pressure stretched past its rest
       // volume (J > 1: the liquid cavitates rather than carry tension), whose
       // domain then counts some empty crack: water's front particle early on
@@ -209,16 +210,18 @@ TEST(KgdScene, ViscosityCiSceneFollowsTheMVertex) {
 // needs (docs/fluid.md). Measured (4 December): 3.0%, 1.8% and 5.8% worst,
 // the fluid front within 2.7%; asserted within about twice that (6%, 4%,
 // 10%), tighter than the CI bounds, so that the closure's gain in length and
-// opening over the default (5.6%, 4.9%, 2.2%) stays held; a growth step is
+// opening over the default (5.5%, 4.9%, 2.2%) stays held; a growth step is
 // 1.4-1.9% of the crack at the compared rows. The pressure is 4-6% low at
 // every row: the finite box makes the body 4-5% more compliant than the
 // M-vertex's infinite one (a net pressure 3% lower at the same injection),
 // and the virtual film eases the flow by (1 + f / w)^3 (docs/verification.md).
+// The fluid's volume fell 4.1e-5 below its compression (water: 6e-5 here) at
+// one row, 4.75 s, where the tip had just grown: allowed 1e-4.
 TEST(KgdScene, ViscosityCiSceneWithTheMatchedClosureFollowsTheMVertex) {
   expect_ci_scene_follows(
       "scenarios/kgd-viscosity-ci.scene", 2.5e-4, [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9,
       {"--set", "fluid.mpm.lag=TIP_ASYMPTOTE_MATCHED", "--set", "solid.mpm.fracture.surfaces_from_material=true"},
-      {0.06, 0.04, 0.10});
+      {0.06, 0.04, 0.10, 1e-4});
 }
 
 // Toughness-dominated (Km = 7.6) against the K-vertex, with water and the

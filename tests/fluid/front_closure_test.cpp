@@ -43,6 +43,32 @@ TEST(FluidSolver, LagPressureBeyondTheFront) {
   }
 }
 
+// A pressure-driven fluid of viscosity mu with the tip closure about the
+// confining stress sigma (matched in level to the fluid or not).
+FluidConfig tip_closure_config(double mu, double p_in, double sigma, bool matched) {
+  FluidConfig c;
+  c.bulk_modulus = 2e9;
+  c.viscosity = mu;
+  c.inlet.kind = InletConfig::Kind::Pressure;
+  c.inlet.pressure = TimeFunction::constant(p_in);
+  c.lag = FluidConfig::Lag::TipAsymptote;
+  c.tip_level_matched = matched;
+  c.lag_pressure = sigma;
+  return c;
+}
+
+// The front's speed as the closure takes it, computed here: the mass-weighted
+// mean velocity of the particles within d of the front (the front one always).
+double front_mean_velocity(const FluidParticles& P, double front, double d) {
+  double m = 0, mv = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    if (P.s[p] < front - d && p + 1 < P.size()) continue;
+    m += P.mass[p];
+    mv += P.mass[p] * P.velocity[p];
+  }
+  return mv / m;
+}
+
 // The tip closure (Lag::TipAsymptote, docs/fluid.md "The tip closure"). The
 // zero-toughness tip solution w = beta (mu' V / E')^(1/3) s^(2/3) must satisfy
 // both lubrication, V w = -(w^3 / mu') dp/ds, which gives
@@ -60,13 +86,7 @@ TEST(FluidSolver, TipAsymptoteClosureIsTheTipSolutionsPressureOneCellBehind) {
     const double beta = std::cbrt(beta3 * 12 * mu * V / E);
     return std::max(0.0, sigma - 3 * 12 * mu * V / (beta * beta) / std::cbrt(d));
   };
-  FluidConfig c;
-  c.bulk_modulus = 2e9;
-  c.viscosity = mu;
-  c.inlet.kind = InletConfig::Kind::Pressure;
-  c.inlet.pressure = TimeFunction::constant(p_in);
-  c.lag = FluidConfig::Lag::TipAsymptote;
-  c.lag_pressure = sigma;
+  FluidConfig c = tip_closure_config(mu, p_in, sigma, false);
   FluidSolver fluid(c);
   auto crack = test::channel(1.0, 20, w);
   EXPECT_THROW(fluid.set_crack(crack), std::invalid_argument);  // the solid sent no E' and cell
@@ -90,14 +110,8 @@ TEST(FluidSolver, TipAsymptoteClosureIsTheTipSolutionsPressureOneCellBehind) {
   EXPECT_GT(sigma - counter(expected), 0.2 * sigma);  // a real suction: a quarter of sigma
   // The closure's own value at the front's speed (the fluid's mean velocity
   // within d of the front), against the independent tip solution.
-  const auto& P = fluid.particles();
-  double m = 0, mv = 0;
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    if (P.s[p] < fluid.front_position() - d && p + 1 < P.size()) continue;
-    m += P.mass[p];
-    mv += P.mass[p] * P.velocity[p];
-  }
-  EXPECT_NEAR(fluid.front_counter_pressure(), counter(mv / m), 1e-6 * sigma);
+  EXPECT_NEAR(fluid.front_counter_pressure(),
+              counter(front_mean_velocity(fluid.particles(), fluid.front_position(), d)), 1e-6 * sigma);
   // The front speed (measured 0.2% above): 1.5%, as for the vacuum front below.
   EXPECT_NEAR(V, expected, 0.015 * expected);
   // A vacuum front would run 60% faster: the test tells them apart.
@@ -130,15 +144,7 @@ TEST(FluidSolver, TipAsymptoteClosureIsTheTipSolutionsPressureOneCellBehind) {
 TEST(FluidSolver, TipAsymptoteClosureMatchesTheTipSolutionToTheFluidBehindTheFront) {
   const double E = 1e7, d = 0.05, mu = 1, w = 1e-3, p_in = 1.1e5, sigma = 1e5, tip = 0.55;
   const double beta3 = 18 * std::sqrt(3.0);  // (beta / (mu' V / E')^(1/3))^3
-  FluidConfig c;
-  c.bulk_modulus = 2e9;
-  c.viscosity = mu;
-  c.inlet.kind = InletConfig::Kind::Pressure;
-  c.inlet.pressure = TimeFunction::constant(p_in);
-  c.lag = FluidConfig::Lag::TipAsymptote;
-  c.tip_level_matched = true;
-  c.lag_pressure = sigma;
-  FluidSolver fluid(c);
+  FluidSolver fluid(tip_closure_config(mu, p_in, sigma, true));
   auto crack = test::channel(tip, 11, w);
   EXPECT_THROW(fluid.set_crack(crack), std::invalid_argument);  // the solid sent no E' and cell
   crack.tip_modulus = E;
@@ -149,14 +155,8 @@ TEST(FluidSolver, TipAsymptoteClosureMatchesTheTipSolutionToTheFluidBehindTheFro
   fluid.advance(0.04);                               // 27 diffusion times L^2 / (K w^2 / 12 mu) of the pressure: steady
   const double front0 = fluid.front_position();
   // The closure, computed here from the fluid's state.
-  const auto& P = fluid.particles();
-  double m = 0, mv = 0;
-  for (std::size_t p = 0; p < P.size(); ++p) {
-    if (P.s[p] < front0 - d && p + 1 < P.size()) continue;
-    m += P.mass[p];
-    mv += P.mass[p] * P.velocity[p];
-  }
-  const double V = mv / m, beta = std::cbrt(beta3 * 12 * mu * V / E), A = 3 * 12 * mu * V / (beta * beta);
+  const double V = front_mean_velocity(fluid.particles(), front0, d), beta = std::cbrt(beta3 * 12 * mu * V / E),
+               A = 3 * 12 * mu * V / (beta * beta);
   // The level p0: the mean of p_i + A (tip - s_i)^(-1/3) over the nodes two
   // to four cells d behind the front (the nodes at 0.35 and 0.40 m here).
   const auto& nodal = fluid.nodal_pressure();
