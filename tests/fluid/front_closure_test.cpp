@@ -43,6 +43,53 @@ TEST(FluidSolver, LagPressureBeyondTheFront) {
   }
 }
 
+// The zero-lag closure (Lag::Front) fills the crack to its tip. A rigid
+// channel closed at its tip (the last element a linear taper to a shut tip),
+// filled from a pressure inlet until the fluid is at rest: at rest the
+// pressure is the inlet's everywhere and the fluid reaches the tip (the
+// exact answer). Before, the tip node was a wall from the start: the front
+// stopped within the tip element where that node's share of it was held,
+// and the front particle, pushed into the dry crack by its own pressure
+// (this closure has no counter-pressure), was squeezed there (measured
+// before the change: the front 20 mm short of the tip in a 25 mm element,
+// the last particle at 2.9 times the inlet's pressure, seven particles
+// outside the 0.5%). The tip is still a wall once the fluid is there:
+// nothing passes it.
+TEST(FluidSolver, ZeroLagFrontFillsTheTipElementAndRestsAtTheInletPressure) {
+  const double w = 1e-3, p_in = 2e5;
+  const auto s = test::uniform_nodes(0.5, 20);
+  std::vector<double> width(s.size(), w);
+  width.back() = 0;  // the shut tip
+  FluidConfig c;
+  c.bulk_modulus = 2e7;
+  c.viscosity = 1e-2;
+  c.inlet.kind = InletConfig::Kind::Pressure;
+  c.inlet.pressure = TimeFunction::constant(p_in);
+  c.lag = FluidConfig::Lag::Front;
+  c.merge_fraction = 0.5;
+  FluidSolver fluid(c);
+  fluid.set_crack(test::straight_crack(s, width));
+  fluid.fill(0.25, p_in);
+  fluid.advance(0.5);  // Poiseuille fills the channel in ~0.05 s; the rest is to come to rest
+  const auto& P = fluid.particles();
+  const double tip = s.back();
+  EXPECT_NEAR(fluid.front_position(), tip, 1e-9 * tip);
+  for (std::size_t p = 0; p < P.size(); ++p) EXPECT_LE(P.end(p), tip) << "particle " << p;
+  // At rest: the pressure within 0.5% of the inlet's at every particle (the
+  // fluid's compression p / K is 1%: its mass is the measure of the filling).
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    EXPECT_NEAR(P.pressure[p], p_in, 0.005 * p_in) << "particle " << p << " at s = " << P.s[p];
+    EXPECT_LT(std::abs(P.velocity[p]), 1e-3) << "particle " << p;
+  }
+  // The channel holds the fluid it can at the inlet's pressure: its volume
+  // (the tip element's taper included) over the volume ratio at p_in.
+  const double capacity = w * (tip - 0.5 * (s[s.size() - 1] - s[s.size() - 2]));
+  double mass = 0;
+  for (double m : P.mass) mass += m;
+  const TaitEos eos{c.bulk_modulus, c.tait_c};
+  EXPECT_NEAR(mass / c.density, capacity / eos.volume_ratio(p_in), 1e-3 * capacity);
+}
+
 // A pressure-driven fluid of viscosity mu with the tip closure about the
 // confining stress sigma (matched in level to the fluid or not).
 FluidConfig tip_closure_config(double mu, double p_in, double sigma, bool matched) {

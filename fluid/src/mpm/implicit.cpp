@@ -91,7 +91,7 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
   for (std::size_t i = 0; i < n; ++i) {
     if (mass_[i] > 0) t.v[i] = (momentum_[i] + dt * t.force[i]) / (mass_[i] + dt * drag_[i]);
   }
-  if (!config_.outlet.enabled) t.v.back() = std::min(0.0, t.v.back());
+  hold_at_tip(t.v);
   // The crack at the end of the step, opened by the solid's response to the nodal pressures.
   const auto& crack = grid_.crack_width();
   const auto& effective = grid_.width();
@@ -118,7 +118,9 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
   t.mass.assign(part.mass.begin(), part.mass.end());
   for (std::size_t p = 0; p < np; ++p) {
     t.a[p] = part.start(p) + dt * interpolate(arc, t.v, part.start(p));
-    t.b[p] = part.end(p) + dt * interpolate(arc, t.v, part.end(p));
+    t.b[p] = end_at_tip(part.end(p) + dt * interpolate(arc, t.v, part.end(p)));
+    if (p + 1 == np && t.b[p] > part.end(p))
+      t.b[p] = std::max(part.end(p), front_end_at_rest(arc, t.width, t.a[p], t.b[p], t.mass[p] / rho0));
     if (!(t.b[p] > t.a[p])) {
       t.squeezed = static_cast<std::ptrdiff_t>(p);
       t.why = "its ends cross";

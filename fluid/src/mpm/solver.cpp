@@ -443,7 +443,49 @@ void FluidSolver::grid_update(double dt) {
   // back from it but not through it. (With a virtual opening the tip node is
   // not closed for the fluid, and particles ran past the tip, beyond the
   // grid, where the CPDI weights are clamped.)
-  if (!config_.outlet.enabled) v_new_.back() = std::min(0.0, v_new_.back());
+  hold_at_tip(v_new_);
+}
+
+void FluidSolver::hold_at_tip(std::vector<double>& v) const {
+  if (tip_holds_fluid()) v.back() = std::min(0.0, v.back());
+}
+
+bool FluidSolver::tip_holds_fluid() const {
+  if (config_.outlet.enabled) return false;
+  if (config_.lag != FluidConfig::Lag::Front) return true;
+  // The zero-lag closure: the fluid fills the crack to its tip, and the tip
+  // is a wall once the fluid is there. Held from within the tip element, the
+  // front stopped where the tip node's hat pushed it back, half a cell short,
+  // and was squeezed there by its own push into the dry crack (the fluid
+  // meets no counter-pressure with this closure): the last crack particle
+  // carried twice the crack's net pressure in kgd-toughness-ci, and at full
+  // size the crack pinched shut behind a stalled tip (docs/verification.md,
+  // "The toughness scenes' front").
+  const std::size_t np = particles_.size();
+  return np > 0 && particles_.end(np - 1) >= grid_.length() * (1 - 1e-12);
+}
+
+double FluidSolver::end_at_tip(double b) const {
+  // With the zero-lag closure a particle's end stops at the tip (above).
+  return !config_.outlet.enabled && config_.lag == FluidConfig::Lag::Front ? std::min(b, grid_.length()) : b;
+}
+
+double FluidSolver::front_end_at_rest(std::span<const double> arc, std::span<const double> width, double a, double b,
+                                      double rest_volume) const {
+  // With the zero-lag closure the front, free of the tip's hold, is drawn
+  // into the dry crack by its own pressure; it may go only as far as its
+  // fluid fills the crack at zero pressure (J = 1), not stretch past it
+  // and cavitate (a 2 MPa fluid's front did, into each new segment, and the
+  // faces, unloaded, slammed shut). Bisection on the end: the volume is
+  // increasing in it.
+  if (config_.outlet.enabled || config_.lag != FluidConfig::Lag::Front || !(b > a)) return b;
+  if (!(integrate(arc, width, a, b) > rest_volume)) return b;
+  double lo = a, hi = b;
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (integrate(arc, width, a, mid) > rest_volume ? hi : lo) = mid;
+  }
+  return lo;
 }
 
 void FluidSolver::g2p(double dt) {
@@ -461,7 +503,9 @@ void FluidSolver::g2p(double dt) {
     P.velocity[p] = (1 - flip) * pic + flip * (P.velocity[p] + change);
     // CPDI corner update: both ends move with the grid velocity there.
     const double a = P.start(p) + dt * interpolate(arc, v_new_, P.start(p));
-    const double b = P.end(p) + dt * interpolate(arc, v_new_, P.end(p));
+    double b = end_at_tip(P.end(p) + dt * interpolate(arc, v_new_, P.end(p)));
+    if (p + 1 == P.size() && b > P.end(p))
+      b = std::max(P.end(p), front_end_at_rest(arc, grid_.width(), a, b, P.mass[p] / config_.density));
     if (!(b > a)) {
       std::ostringstream out;
       out << "fluid: particle " << p << " at s = " << P.s[p] << " m turned inside out in a step of " << dt
