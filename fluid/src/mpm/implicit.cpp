@@ -118,9 +118,8 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
   t.mass.assign(part.mass.begin(), part.mass.end());
   for (std::size_t p = 0; p < np; ++p) {
     t.a[p] = part.start(p) + dt * interpolate(arc, t.v, part.start(p));
-    t.b[p] = end_at_tip(part.end(p) + dt * interpolate(arc, t.v, part.end(p)));
-    if (p + 1 == np && t.b[p] > part.end(p))
-      t.b[p] = std::max(part.end(p), front_end_at_rest(arc, t.width, t.a[p], t.b[p], t.mass[p] / rho0));
+    t.b[p] = moved_end(p + 1 == np, part.end(p), t.a[p], part.end(p) + dt * interpolate(arc, t.v, part.end(p)), arc,
+                       t.width, t.mass[p] / rho0);
     if (!(t.b[p] > t.a[p])) {
       t.squeezed = static_cast<std::ptrdiff_t>(p);
       t.why = "its ends cross";

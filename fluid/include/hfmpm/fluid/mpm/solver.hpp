@@ -248,18 +248,20 @@ class FluidSolver {
   void pressure_force(const std::vector<double>& pp, double mouth, std::vector<double>& force) const;
   // The push of front_counter_pressure() back on the front end (a no-op when it is 0).
   void front_force(std::vector<double>& force) const;
+  // The zero-lag closure (Lag::Front, no outlet) fills the crack to its tip
+  // (fluid/src/mpm/front.cpp).
+  bool fills_to_tip() const;
   // Whether the closed tip's node holds the fluid back this step (its
-  // velocity at most 0): always without an outlet, but with the zero-lag
-  // closure (Lag::Front) only once the fluid has reached the tip; and a
-  // particle end moved past the tip, which only that closure allows, is put
-  // back at the tip.
+  // velocity at most 0): always without an outlet, but when the fluid fills
+  // to the tip only once it has reached it.
   bool tip_holds_fluid() const;
   void hold_at_tip(std::vector<double>& v) const;  // the tip node's velocity, as above
-  // With the zero-lag closure, the front particle's end b (from a) no
-  // further than its rest volume fills the crack (no cavitating stretch).
-  double front_end_at_rest(std::span<const double> arc, std::span<const double> width, double a, double b,
-                           double rest_volume) const;
-  double end_at_tip(double b) const;
+  // A particle end moved from old_end to b (its start at a): when the fluid
+  // fills to the tip, no further than the tip, and the front's (front) no
+  // further than its rest volume fills the crack's width (no cavitating
+  // stretch). Otherwise b.
+  double moved_end(bool front, double old_end, double a, double b, std::span<const double> arc,
+                   std::span<const double> width, double rest_volume) const;
 
   FluidConfig config_;
   TaitEos eos_;
