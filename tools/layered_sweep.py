@@ -27,6 +27,7 @@ no fluid follows.
 import argparse
 import csv
 import json
+import math
 import os
 import re
 import signal
@@ -78,6 +79,22 @@ def mean_y(xs, ys, a, b):
     pts = [y_at(xs, ys, a + (b - a) * k / n) for k in range(n + 1)]
     pts = [p for p in pts if p is not None]
     return sum(pts) / len(pts) if pts else float("nan")
+
+
+def path_shape(xs, ys):
+    """The largest zig-zag of a path (the largest distance of a crack particle from the chord of
+    its two neighbours, m) and its kinks (the angles between successive segments, deg)."""
+    zig, kinks = 0.0, []
+    for i in range(1, len(xs) - 1):
+        ax, ay, bx, by = xs[i - 1], ys[i - 1], xs[i + 1], ys[i + 1]
+        cx, cy = bx - ax, by - ay
+        n = math.hypot(cx, cy)
+        if n > 0:
+            zig = max(zig, abs((xs[i] - ax) * cy - (ys[i] - ay) * cx) / n)
+        a1 = math.atan2(ys[i] - ay, xs[i] - ax)
+        a2 = math.atan2(by - ys[i], bx - xs[i])
+        kinks.append(abs(math.degrees(math.remainder(a2 - a1, 2 * math.pi))))
+    return zig, kinks
 
 
 def main():
@@ -145,6 +162,9 @@ def main():
             row = {"start": start, "viscosity_pa_s": mu, "out": out, "status": status}
             if status != "failed":
                 xs, ys = final_path(out)
+                zig, kinks = path_shape(xs, ys)
+                row.update(zigzag_cells=zig / cell, kinks_over_30=sum(k > 30 for k in kinks),
+                           largest_kink_deg=max(kinks, default=0.0))
                 row.update(path=(xs, ys), reach_m=xs[-1], tip_y_m=ys[-1],
                            deviation_m=toward * (ys[-1] - y0),
                            propagated=xs[-1] > cx[-1] + 2 * cell + 1e-6)
@@ -176,22 +196,26 @@ def main():
                 r["max_ke_over_work"] = float("nan")
     print(f"| start | viscosity (Pa s) | grew to x (m) | deviation at the tip (m) | deviation at x = {x_near:g} m "
           "(2 cells past the notch) | compared at x (m) | deviation there (m) | mean offset from the notch's tip to "
-          "there (m) | propagated (> 2 cells) | largest KE / fluid work |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "there (m) | propagated (> 2 cells) | largest KE / fluid work | zig-zag (cells) | kinks > 30 deg "
+          "(largest) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     nan = float("nan")
     for r in rows:
         if r["status"] == "failed":
-            print(f"| {r['start']} | {r['viscosity_pa_s']:g} | run failed | | | | | | | |")
+            print(f"| {r['start']} | {r['viscosity_pa_s']:g} | run failed | | | | | | | | | |")
             continue
         print(f"| {r['start']} | {r['viscosity_pa_s']:g} | {r['reach_m']:.2f} | {r['deviation_m']:+.3f} | "
               f"{r.get('deviation_near_m', nan):+.3f} | "
               f"{r.get('x_common_m', nan):.2f} | {r.get('deviation_at_common_m', nan):+.3f} | "
               f"{r.get('mean_offset_m', nan):+.3f} | {'yes' if r['propagated'] else 'no'} | "
-              f"{r.get('max_ke_over_work', nan):.2g} |")
-    print("deviation > 0: toward the other layer (the interface)")
+              f"{r.get('max_ke_over_work', nan):.2g} | {r['zigzag_cells']:.2f} | "
+              f"{r['kinks_over_30']} ({r['largest_kink_deg']:.0f} deg) |")
+    print("deviation > 0: toward the other layer (the interface); zig-zag: the largest distance of a crack "
+          "particle from the chord of its two neighbours, in cells; kinks: angles between successive segments")
     with open(os.path.join(a.out, "summary.csv"), "w", newline="") as f:
         keys = ["start", "viscosity_pa_s", "status", "reach_m", "tip_y_m", "deviation_m", "deviation_near_m",
-                "x_common_m", "deviation_at_common_m", "mean_offset_m", "propagated", "max_ke_over_work"]
+                "x_common_m", "deviation_at_common_m", "mean_offset_m", "propagated", "max_ke_over_work",
+                "zigzag_cells", "kinks_over_30", "largest_kink_deg"]
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)

@@ -185,6 +185,27 @@ Turned turn_in_anisotropic_stress(double h, double length) {
           j_over_k(g.tip), tip.k1, g.tip.k1, tip.k2 / tip.k1, g.tip.k2 / g.tip.k1);
     }
   }
+  // HFMPM_PATH_OUT=file writes the path for tools/curved_path.py: every
+  // growth decision (the tip, its count, the time and face pressure of the
+  // check, the new tip particle, the K's and kink the check measured), then
+  // the final crack's particles.
+  if (const char* path = std::getenv("HFMPM_PATH_OUT")) {
+    std::FILE* f = std::fopen(path, "w");
+    if (f == nullptr) ADD_FAILURE() << "cannot write HFMPM_PATH_OUT=" << path;
+    if (f != nullptr) {
+      std::fprintf(f, "record,tip,step,time_s,pressure_pa,x_m,y_m,k1_pa_sqrt_m,k2_pa_sqrt_m,kink_deg,h_m\n");
+      for (const auto& g : log) {
+        const Vec2& x = g.tip.at_end ? g.plane.back() : g.plane.front();
+        std::fprintf(f, "growth,%s,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", g.tip.at_end ? "end" : "start",
+                     g.tip.at_end ? g.end_grown : g.start_grown, g.time, pressure(g.time), x.x(), x.y(), g.tip.k1,
+                     g.tip.k2, g.tip.kink * 180 / kPi, h);
+      }
+      const auto& plane = solid.cracks()[0].plane();
+      for (std::size_t i = 0; i < plane.size(); ++i)
+        std::fprintf(f, "plane,,%zu,,,%.9g,%.9g,,,,%.9g\n", i, plane[i].x(), plane[i].y(), h);
+      std::fclose(f);
+    }
+  }
   Turned out;
   out.plane = solid.cracks()[0].plane();
   out.start_initial = static_cast<std::size_t>(log.empty() ? 0 : log.back().start_grown);
