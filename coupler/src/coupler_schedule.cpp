@@ -241,7 +241,15 @@ void Coupler::step_loop(RunSummary& summary) {
     // time.max_steps, in whole exchange windows (a command never splits one).
     const std::uint64_t to_max = (max_steps - step_) / k * k;
     if (to_max == 0) break;
-    const std::uint64_t n = std::min({block, steps_to(std::min(next_output, end)), to_max});
+    // Commands end at every multiple of the control block (counted from step 0,
+    // not from the last output) and at output times. The step is re-chosen and
+    // the energy checked only at the block's multiples and at the end, so
+    // neither the answer nor a run's verdict depends on the output interval
+    // (an output time used to restart the block and add a sample: a layered
+    // run's energy check stopped it with output every 20 ms and not with
+    // every 1 ms, its exchanges bit-for-bit the same; docs/protocol.md).
+    const std::uint64_t to_control = block - step_ % block;
+    const std::uint64_t n = std::min({to_control, steps_to(std::min(next_output, end)), to_max});
     const double t_end = t_ + static_cast<double>(n) * dt;
     const bool last_allowed = n == to_max && max_steps - step_ - n < k;
     const bool output = t_end >= next_output * (1 - 1e-12) || t_end >= end * (1 - 1e-12) || last_allowed;
@@ -291,8 +299,9 @@ void Coupler::step_loop(RunSummary& summary) {
       max_coupling_lag_ = sides_[1].diagnostics.coupling_lag;
       max_coupling_lag_t_ = t_;
     }
-    if (rest_) rest_->update(t_, sides_[0].diagnostics);
-    if (energy_) {
+    const bool at_control = step_ % block == 0 || t_ >= end * (1 - 1e-12) || last_allowed;
+    if (rest_ && at_control) rest_->update(t_, sides_[0].diagnostics);
+    if (energy_ && at_control) {
       if (auto failure = energy_->update(t_, step_, sides_[0].diagnostics, sides_[1].diagnostics)) {
         history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
         throw RunFailure{*failure};
@@ -303,7 +312,7 @@ void Coupler::step_loop(RunSummary& summary) {
       ++frame;
       while (next_output <= t_ * (1 + 1e-12)) next_output += interval;
     }
-    if (t_ < end * (1 - 1e-12)) dt = next_dt();
+    if (at_control && t_ < end * (1 - 1e-12)) dt = next_dt();
     if (checkpoint) {
       for (const auto& side : sides_) {
         if (side.expected && !side.report->checkpoint_written()) {
