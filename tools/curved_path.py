@@ -302,17 +302,41 @@ def self_test():
     return ok
 
 
+COLUMNS = ("record", "tip", "step", "pressure_pa", "x_m", "y_m", "k1_pa_sqrt_m", "k2_pa_sqrt_m", "h_m")
+
+
 def read_run(path):
+    """An MPM path file (HFMPM_PATH_OUT): its growth records, its final crack and its cell size.
+    A file that cannot be read, lacks a column or holds a value that is not a number stops the
+    tool with a message naming the file, the line and what is expected."""
     growth, plane, h = [], [], None
-    with open(path) as f:
-        for row in csv.DictReader(f):
-            h = float(row["h_m"])
-            if row["record"] == "growth":
-                growth.append({"tip": row["tip"], "step": int(row["step"]), "p": float(row["pressure_pa"]),
-                               "x": float(row["x_m"]), "y": float(row["y_m"]), "k1": float(row["k1_pa_sqrt_m"]),
-                               "k2": float(row["k2_pa_sqrt_m"])})
-            else:
-                plane.append((float(row["x_m"]), float(row["y_m"])))
+    try:
+        f = open(path)
+    except OSError as e:
+        sys.exit(f"curved_path: cannot read {path}: {e.strerror}")
+    with f:
+        reader = csv.DictReader(f)
+        missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
+        if missing:
+            sys.exit(f"curved_path: {path}: not a path file written with HFMPM_PATH_OUT (missing columns: "
+                     f"{', '.join(missing)})")
+        for row in reader:
+            try:
+                h = float(row["h_m"])
+                if row["record"] == "growth":
+                    growth.append({"tip": row["tip"], "step": int(row["step"]), "p": float(row["pressure_pa"]),
+                                   "x": float(row["x_m"]), "y": float(row["y_m"]),
+                                   "k1": float(row["k1_pa_sqrt_m"]), "k2": float(row["k2_pa_sqrt_m"])})
+                elif row["record"] == "plane":
+                    plane.append((float(row["x_m"]), float(row["y_m"])))
+                else:
+                    raise ValueError(f"record {row['record']!r}, expected 'growth' or 'plane'")
+            except (TypeError, ValueError) as e:
+                sys.exit(f"curved_path: {path}, line {reader.line_num}: {e}")
+    if not (h is not None and math.isfinite(h) and h > 0):
+        sys.exit(f"curved_path: {path}: no cell size h_m > 0 (got {h})")
+    if len(plane) < 2:
+        sys.exit(f"curved_path: {path}: the final crack has {len(plane)} points; at least 2 expected")
     return growth, np.array(plane), h
 
 
