@@ -139,7 +139,7 @@ def solve(points, stress, pressure, box=None, box_size=0.25):
     return D[0:2 * nc:2], D[1:2 * nc:2], a[:nc]
 
 
-def tip_k(points, ds, dn, a, at_end, last=6):
+def tip_k(ds, dn, a, at_end, last=6):
     """K_I and K_II at a tip, in the tip's frame (x1 out of the crack, x2 to its left), from
     the near-tip field's opening w = 8 K_I sqrt(r / 2 pi) / E' (and sliding with K_II): the
     apparent K at the centres of the elements 1..last from the tip (the tip element 0, a
@@ -208,7 +208,7 @@ def grow(path, stress, pressures, step, box=None):
         ds, dn, a = solve(elements, stress, p, box)
         new = []
         for at_end in (False, True):
-            k1, k2 = tip_k(elements, ds, dn, a, at_end)
+            k1, k2 = tip_k(ds, dn, a, at_end)
             tip, prev = (pts[-1], pts[-2]) if at_end else (pts[0], pts[1])
             d = (tip - prev) / np.linalg.norm(tip - prev)
             th = kink_angle(k1, k2)
@@ -240,15 +240,15 @@ def self_test():
         a, p = 1.0, 1e6
         pts = straight((0, 0), 0.3, a, n)
         ds, dn, el = solve(pts, (0, 0, 0), p)
-        k1, k2 = tip_k(pts, ds, dn, el, True)
+        k1, k2 = tip_k(ds, dn, el, True)
         e1 = check("Griffith, pressure 1 MPa: K_I", k1, p * math.sqrt(math.pi * a), 0.01)
         print(f"  K_II {k2:.3g} (0 exact)")
         # 45 deg crack under sigma_yy = 1 MPa: K_I = K_II = sigma/2 sqrt(pi a); the end tip's kink -53.13 deg
         pts = straight((0, 0), math.pi / 4, a, n)
         ds, dn, el = solve(pts, (0, 1e6, 0), 0)
         kk = 0.5e6 * math.sqrt(math.pi * a)
-        k1e, k2e = tip_k(pts, ds, dn, el, True)
-        k1s, k2s = tip_k(pts, ds, dn, el, False)
+        k1e, k2e = tip_k(ds, dn, el, True)
+        k1s, k2s = tip_k(ds, dn, el, False)
         e2 = check("45 deg under tension, end tip: K_I", k1e, kk, 0.01)
         e3 = check("  K_II", k2e, kk, 0.01)
         check("  start tip K_I", k1s, kk, 0.01)
@@ -260,7 +260,7 @@ def self_test():
     # exactly, and K_I = 0 (the faces press).
     pts = straight((0, 0), math.pi / 4, 1.0, 80)
     ds, dn, el = solve(pts, STRESS, 0)
-    k1, k2 = tip_k(pts, ds, dn, el, True)
+    k1, k2 = tip_k(ds, dn, el, True)
     print("45 deg crack shut by sigma_xx = -2, sigma_yy = -6 MPa, frictionless, 80 elements:")
     check("  |K_II|", abs(k2), 2e6 * math.sqrt(math.pi), 0.01)
     good = abs(k1) < 1e-3 * abs(k2) and np.all(dn <= 0)
@@ -285,7 +285,7 @@ def self_test():
         u = np.array([math.cos(math.pi / 4 + th), math.sin(math.pi / 4 + th)])
         pts += [pts[-1] + u * 0.002 * (i + 1) for i in range(10)]
         ds, dn, el = solve(pts, (0, 1e6, 0), 0)
-        k1, k2 = tip_k(pts, ds, dn, el, True)
+        k1, k2 = tip_k(ds, dn, el, True)
         c1, c2 = cotterell_rice(th, kk, kk)
         print(f"kink of {deg:g} deg, 0.02 a long:")
         check("  K_I against the first-order kink solution", k1, c1, 0.015)
