@@ -38,6 +38,7 @@ int Solver::propagate() {
   last_tips_ = tips();
   const double h = config_.grid.h;
   int added = 0;
+  std::vector<std::array<Vec2, 2>> cut;  // the new segments, old tip to new
   if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
   if (front_arrived_at_.size() != cracks_.size()) front_arrived_at_.resize(cracks_.size(), -kForever);
   // Each crack's length before this check grows any tip: the settling wait of
@@ -126,9 +127,14 @@ int Solver::propagate() {
     } else {
       crack.prepend(next, reference);
     }
+    cut.push_back({tip.position, next});
     grown_at = t_;
     if (tip.at_end && tip.crack < front_arrived_at_.size()) front_arrived_at_[tip.crack] = -kForever;
     ++added;
+  }
+  if (!cut.empty() && config_.fracture.reproject_grown) {
+    for (auto& crack : cracks_) crack.prepare(3 * h, 1e-6 * h);
+    reproject_strains(cut);
   }
   return added;
 }

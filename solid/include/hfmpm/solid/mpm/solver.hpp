@@ -199,6 +199,10 @@ class Solver {
   void implicit_face_stiffness(double dt);
   void keep_fixed(std::size_t u, int f);
   void affine_displacement();
+  // After growth: the particles within two cells of the new segments (each
+  // from the old tip to the new) take the displacement gradient of their
+  // fields' nodal displacements; returns how many (transfer.cpp).
+  int reproject_strains(const std::vector<std::array<Vec2, 2>>& segments);
   void anchor_crack_surfaces();
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
