@@ -339,10 +339,13 @@ namespace {
 // cells; the particle half a cell from the tip is left out).
 struct OpeningProfile {
   std::vector<double> x, surfaces, material;
+  double j = 0;  // J at the tip, J/m^2
 };
 
+// pressurised: the load is a face pressure equal to the tension (the edges
+// free) instead of the tension.
 OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool from_material = false,
-                                  bool reproject = true) {
+                                  bool reproject = true, bool pressurised = false) {
   constexpr double kW = 1, kH = 1.5, kFinal = 0.4;
   const double sigma =
       0.5 * std::sqrt(kRock.plane_strain_modulus() * 500) / (tada_edge_factor(0.3 / kW) * std::sqrt(kPi * 0.3));
@@ -354,7 +357,7 @@ OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool f
   const double t_full = 12 * transit, t_end = (pre ? 35.0 : 25.0) * transit;
   auto config = edge_crack(kW, a, kH, 20,
                            pre ? TimeFunction::table({0, t_full, t_full + 3 * transit}, {f * sigma, f * sigma, sigma})
-                               : TimeFunction::constant(sigma));
+                               : TimeFunction::constant(pressurised ? 0.0 : sigma));
   const double h = config.grid.h;
   if (between_rows) {
     config.grid.origin.y() -= 0.5 * h;
@@ -374,11 +377,13 @@ OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool f
     const double tip = solid.cracks()[0].plane().back().x();
     const bool may_grow = grow && tip < kFinal - 0.1 * h && solid.time() > 5 * transit;
     solid.set_crack_front(0, may_grow ? tip : 0.0);
+    if (pressurised) solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), sigma));
     solid.step(dt);
   }
   std::printf("%s crack, %s: %llu node contacts\n", grow ? "grown" : "cut", between_rows ? "between rows" : "on a row",
               static_cast<unsigned long long>(solid.contacts()));
   OpeningProfile out;
+  out.j = solid.tips().at(0).j;
   const auto& crack = solid.cracks()[0];
   const auto& p = solid.particles();
   for (std::size_t k = 0; k < crack.size(); ++k) {
@@ -410,7 +415,12 @@ OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool f
 // between rows, the particles beside the grown faces keep +-2 MPa under a
 // 0.7 MPa tension and the grown part opens 0.885 and 0.964 of the cut
 // crack's at 2 and 1.5 cells (asserted below 0.92 at one of them, so that
-// the comparison shows what it measures). 5%: the cut crack's own opening
+// the comparison shows what it measures). The same between rows with the
+// load a face pressure (the edges free, the KGD's load): material 1.001-1.031
+// from x = 0.225 to 0.325. J of the grown crack within 1% of the cut crack's
+// in all three (measured +0.02%, +0.02%, -0.28%; without the reprojection
+// -0.5% under tension: J, an integral over a domain of three cells, hardly
+// sees the defect, the opening does). 5%: the cut crack's own opening
 // two cells from the tip is within a few percent of the exact one at this
 // resolution, and the reprojected gradient is a cell-wide average of the
 // one it replaces. The crack particles' own surfaces (integrated from their
@@ -421,17 +431,21 @@ OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool f
 TEST(Propagation, GrownCrackMaterialOpensAsACrackCutAtThatLength) {
   const double h = 1.0 / 20;
   for (const bool between_rows : {false, true}) {
-    const auto cut = edge_crack_opening(0.4, false, between_rows);
-    const auto grown = edge_crack_opening(0.3, true, between_rows);
-    ASSERT_EQ(cut.x.size(), grown.x.size());
-    const double tip = cut.x.back();
-    std::printf("%s: x, grown/cut opening (surfaces, material)\n",
-                between_rows ? "between node rows" : "on a node row");
-    for (std::size_t k = 1; k + 1 < cut.x.size(); ++k) {
-      const double rs = grown.surfaces[k] / cut.surfaces[k], rm = grown.material[k] / cut.material[k];
-      std::printf("  %.4f %.4f %.4f\n", cut.x[k], rs, rm);
-      if (tip - cut.x[k] < 1.5 * h - 1e-9) continue;  // the particle next to the tip
-      EXPECT_NEAR(rm, 1, 0.05) << (between_rows ? "between rows" : "on a row") << ", x = " << cut.x[k];
+    for (const bool pressurised : {false, true}) {
+      if (pressurised && !between_rows) continue;
+      const auto cut = edge_crack_opening(0.4, false, between_rows, false, true, pressurised);
+      const auto grown = edge_crack_opening(0.3, true, between_rows, false, true, pressurised);
+      ASSERT_EQ(cut.x.size(), grown.x.size());
+      const double tip = cut.x.back();
+      const char* where = between_rows ? (pressurised ? "between rows, pressurised" : "between rows") : "on a row";
+      std::printf("%s: J grown / cut %.5f; x, grown/cut opening (surfaces, material)\n", where, grown.j / cut.j);
+      EXPECT_NEAR(grown.j / cut.j, 1, 0.01) << where;
+      for (std::size_t k = 1; k + 1 < cut.x.size(); ++k) {
+        const double rs = grown.surfaces[k] / cut.surfaces[k], rm = grown.material[k] / cut.material[k];
+        std::printf("  %.4f %.4f %.4f\n", cut.x[k], rs, rm);
+        if (tip - cut.x[k] < 1.5 * h - 1e-9) continue;  // the particle next to the tip
+        EXPECT_NEAR(rm, 1, 0.05) << where << ", x = " << cut.x[k];
+      }
     }
   }
   const auto cut = edge_crack_opening(0.4, false, true);
