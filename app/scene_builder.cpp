@@ -321,8 +321,10 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "#   closure: "
     << (d.viscosity_dominated
             ? "the dry tip zone carries the confining stress normal to the crack and the fluid\n"
-              "#   front meets the zero-toughness tip solution's pressure one cell from the tip (zero lag);\n"
-              "#   the tip waits for the fluid within 0.25 cell and grows by 0.25 cell.\n"
+              "#   front meets the zero-toughness tip solution, its level matched to the fluid's pressures\n"
+              "#   two to four cells behind the front, one cell from the tip (zero lag); the faces' opening is\n"
+              "#   read from the material, which that closure needs; the tip waits for the fluid within\n"
+              "#   0.25 cell and grows by 0.25 cell.\n"
             : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
               "#   the tip waits for the fluid within 0.25 cell, grows by 0.25 cell and lets the "
               "opening follow (2 transits).\n")
@@ -362,7 +364,8 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "    damping { grid_alpha_per_s: " << num(d.damping) << " pic_fraction: 0.5 }\n"
     << "    fracture { j_inner_cells: 1 j_outer_cells: 3 propagate: true growth_cells: " << num(growth)
     << " check_interval: 2 direction: STRAIGHT\n               max_lag_cells: " << num(growth)
-    << (settle > 0 ? " settle_transits: 2" : "") << " }\n"
+    << (settle > 0 ? " settle_transits: 2" : "") << (d.viscosity_dominated ? " surfaces_from_material: true" : "")
+    << " }\n"
     << "    cracks { x_m: [0, " << num(p.notch_m()) << "] y_m: [0, 0] start_is_tip: false end_is_tip: true }\n"
     << "  }\n}\n"
     << "fluid {\n  mpm {\n"
@@ -375,7 +378,7 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "    initial_fill { front_m: " << num(p.notch_m()) << " pressure_pa: " << num(sigma_n) << " }\n"
     << "    virtual_opening_m: " << num(d.virtual_opening) << "\n";
   if (d.viscosity_dominated) {
-    s << "    lag: TIP_ASYMPTOTE lag_pressure_pa: " << num(sigma_n) << "\n";
+    s << "    lag: TIP_ASYMPTOTE_MATCHED lag_pressure_pa: " << num(sigma_n) << "\n";
   } else {
     s << "    lag: FRONT_PRESSURE\n";
   }

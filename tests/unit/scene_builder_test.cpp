@@ -112,7 +112,8 @@ TEST(SceneBuilder, ViscosityDominatedSceneFollowsItsDerivation) {
   EXPECT_LE(alpha / (omega * omega), 0.02 * t_3);
   EXPECT_GE(alpha / (omega * omega), 0.018 * t_3);  // the lag bound is the one that acts here
   // The viscous closure: the dry zone at the confining stress, the tip waiting for the fluid.
-  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE);
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE_MATCHED);
+  EXPECT_TRUE(mpm.fracture().surfaces_from_material());  // the matched closure needs the true widths
   EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e6);
   EXPECT_DOUBLE_EQ(mpm.fracture().max_lag_cells(), 0.25);
   EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
