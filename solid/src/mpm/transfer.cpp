@@ -270,7 +270,8 @@ void Solver::affine_displacement() {
 // stress the new faces cannot relieve: particles beside a grown crack kept
 // +-2 MPa under a 0.7 MPa tension, and the grown part opened 0.86-0.96 of
 // the cut crack's (the material's opening; tests/solid/propagation_test.cpp).
-// So each particle the new segments cut off from a stencil node takes the
+// So each particle that uses a node whose particles the new segments
+// re-sort (the line from some particle to it crosses a new segment) takes the
 // gradient of its fields' nodal displacements (every particle's displacement
 // carried to its stencil nodes with its own gradient, mass weighted per
 // field: exact for a linear field), and its stress changes by C : the
@@ -280,9 +281,13 @@ int Solver::reproject_strains(const std::vector<std::array<Vec2, 2>>& segments) 
   if (segments.empty() || particles_.grad_u.empty()) return 0;
   const Grid g = config_.grid;
   // A stencil node lies within 1.5 h + lp <= 2 h of its particle in each
-  // direction: a cut particle lies within 2 sqrt(2) h of a new segment, and
-  // a particle that reaches one of its nodes within twice that.
-  const double reach = 2 * std::sqrt(2.0) * g.h, gather = 3 * reach;
+  // direction, so within reach = 2 sqrt(2) h: a re-sorted node lies within
+  // reach of a new segment (the line to it from some particle crosses the
+  // segment), a particle using it within 2 reach, that particle's nodes
+  // within 3 reach, and every particle that contributes to them within
+  // 4 reach: the sums over gathered particles are whole at every node a
+  // target reads.
+  const double reach = 2 * std::sqrt(2.0) * g.h, gather = 4 * reach;
   auto distance = [&](const Vec2& x) {
     double best = std::numeric_limits<double>::infinity();
     for (const auto& s : segments) {

@@ -101,8 +101,8 @@ struct Fracture {
   // (Solver::anchor_crack_surfaces); false: the surfaces only integrate
   // their fields' velocities.
   bool surfaces_from_material = false;
-  // After a growth step, the particles within two cells of the new segment
-  // take the strain of their fields' nodal displacements (the strain a crack
+  // After a growth step, the particles using a node the new segment re-sorts
+  // into fields take the strain of their fields' nodal displacements (the strain a crack
   // cut there from the start gives them; Solver::reproject_strains). false:
   // they keep the strain the uncut body gave them (for comparison only).
   bool reproject_grown = true;

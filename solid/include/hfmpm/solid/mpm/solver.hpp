@@ -199,9 +199,10 @@ class Solver {
   void implicit_face_stiffness(double dt);
   void keep_fixed(std::size_t u, int f);
   void affine_displacement();
-  // After growth: the particles within two cells of the new segments (each
-  // from the old tip to the new) take the displacement gradient of their
-  // fields' nodal displacements; returns how many (transfer.cpp).
+  // After growth: the particles using a node that the new segments (each
+  // from the old tip to the new) re-sort into fields take the displacement
+  // gradient of their fields' nodal displacements; returns how many
+  // (transfer.cpp).
   int reproject_strains(const std::vector<std::array<Vec2, 2>>& segments);
   void anchor_crack_surfaces();
   void move_crack_surfaces(double dt);
