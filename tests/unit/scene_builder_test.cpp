@@ -134,12 +134,19 @@ TEST(SceneBuilder, ToughnessDominatedSceneTakesTheToughnessClosure) {
   EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);
   EXPECT_DOUBLE_EQ(mpm.fracture().growth_cells(), 0.25);
   EXPECT_DOUBLE_EQ(mpm.fracture().settle_transits(), 2);
+  // The faces read from the material (docs/verification.md, "A growth step
+  // without a jolt").
+  EXPECT_TRUE(mpm.fracture().surfaces_from_material());
   // The settling wait (2 shear transits of the crack per quarter-cell step) lets the tip
   // run at least twice the K-vertex's final speed (2/3) l / t.
   const double l = 0.6274368, h = mpm.cell_size_m();
   const double c_s = std::sqrt(1e7 / 2.5 / (2500 * mpm.density_scaling()));
   const double cap = 0.25 * h / (2 * l / c_s), v_tip = 2.0 / 3.0 * l / 5;
   EXPECT_GE(cap, 2 * v_tip * 0.999);
+  // Damping critical for the crack's quarter-wave mode at three notch lengths
+  // (0.45 m), omega_c = pi c_s / (2 L_3), to the two digits the builder writes.
+  const double omega_c = std::numbers::pi * c_s / (2 * 0.45);
+  EXPECT_NEAR(mpm.damping().grid_alpha_per_s(), 2 * omega_c, 0.05 * 2 * omega_c);
   // The in-situ stress: yy normal to the crack, xx along it.
   EXPECT_DOUBLE_EQ(mpm.regions(0).initial_stress().yy_pa(), -1e5);
   EXPECT_DOUBLE_EQ(mpm.regions(0).initial_stress().xx_pa(), -2e5);

@@ -107,6 +107,16 @@ void Solver::save(StateWriter& out) const {
   for (const auto& g : grown_at_) grown.insert(grown.end(), g.begin(), g.end());
   out.put("grown_at", grown);
   out.put("front_arrived_at", front_arrived_at_);
+  out.put("anchored_at", anchored_at_);
+  std::vector<Vec2> drift;  // per crack particle, above then below (the crack's size known)
+  for (std::size_t c = 0; c < cracks_.size(); ++c) {
+    if (c >= surface_drift_.size() || surface_drift_[c].size() != cracks_[c].size()) {
+      drift.assign(0, Vec2::Zero());
+      break;
+    }
+    for (const auto& d : surface_drift_[c]) drift.insert(drift.end(), d.begin(), d.end());
+  }
+  out.put("surface_drift", drift);
   std::vector<std::uint64_t> tip_crack, tip_end, tip_material;
   std::vector<Vec2> tip_position, tip_direction;
   std::vector<double> tip_j, tip_j_faces, tip_k1, tip_k2, tip_kink, tip_toughness, tip_modulus;
@@ -193,6 +203,27 @@ void Solver::load(const StateReader& in) {
   grown_at_.resize(grown.size() / 2);
   for (std::size_t i = 0; i < grown_at_.size(); ++i) grown_at_[i] = {grown[2 * i], grown[2 * i + 1]};
   in.get("front_arrived_at", front_arrived_at_);
+  in.get("anchored_at", anchored_at_);
+  std::vector<double> drift;
+  in.get("surface_drift", drift);
+  surface_drift_.clear();
+  if (!drift.empty()) {
+    std::size_t want = 0;
+    for (const auto& crack : cracks_) want += 4 * crack.size();
+    if (drift.size() != want) {
+      throw std::runtime_error("checkpoint array surface_drift has " + std::to_string(drift.size()) +
+                               " values; the cracks' particles need " + std::to_string(want));
+    }
+    std::size_t i = 0;
+    surface_drift_.resize(cracks_.size());
+    for (std::size_t c = 0; c < cracks_.size(); ++c) {
+      surface_drift_[c].resize(cracks_[c].size());
+      for (auto& d : surface_drift_[c]) {
+        d = {Vec2(drift[i], drift[i + 1]), Vec2(drift[i + 2], drift[i + 3])};
+        i += 4;
+      }
+    }
+  }
   std::vector<std::uint64_t> tip_crack, tip_end, tip_material;
   std::vector<Vec2> tip_position, tip_direction;
   std::vector<double> tip_j, tip_j_faces, tip_k1, tip_k2, tip_kink, tip_toughness, tip_modulus;

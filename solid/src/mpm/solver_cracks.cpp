@@ -212,6 +212,9 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
       side_a[s] = a_sum / mass;
       if (tip(k)) continue;  // both surfaces of a tip move together: no opening
       out.rate[k] += side * v_sum.dot(n) / mass;
+      if (c < surface_drift_.size() && surface_drift_[c].size() == count) {
+        out.rate[k] += side * surface_drift_[c][k][static_cast<std::size_t>(s)].dot(n);  // anchor_crack_surfaces
+      }
       out.acceleration[k] += side * a_sum.dot(n) / mass;
       for (auto& r : mine) reads[k].push_back({r.key, side * r.weight / mass});
     }
@@ -357,8 +360,23 @@ void Solver::anchor_crack_surfaces() {
   const auto& g = config_.grid;
   const NodalFields* fields[2] = {&field0_, &field1_};
   affine_displacement();
-  for (auto& crack : cracks_) {
+  // The relaxation is a drift velocity the surfaces add to their fields'
+  // over the coming step (move_crack_surfaces), and face_response reports it
+  // with the faces' opening rate, so the fluid's implicit solve sees it
+  // coming. Over the last step's length dt it closes the fraction
+  // 1 - exp(-dt / tau) of the gap: (target - surface) (1 - exp(-dt / tau)) / dt.
+  // The first anchoring, and tau = 0, set the surfaces outright.
+  const double elapsed = anchored_at_ >= 0 ? t_ - anchored_at_ : -1;
+  anchored_at_ = t_;
+  surface_drift_.resize(cracks_.size());
+  for (std::size_t c = 0; c < cracks_.size(); ++c) {
+    auto& crack = cracks_[c];
+    const double tau = config_.fracture.surface_relax_transits * crack_transit(c);
+    const bool drift = elapsed > 0 && tau > 0;
+    const double rate = drift ? -std::expm1(-elapsed / tau) / elapsed : 0.0;  // 1/s
     const std::size_t count = crack.size();
+    auto& velocity = surface_drift_[c];
+    velocity.assign(count, {Vec2::Zero(), Vec2::Zero()});
     for (std::size_t k = 0; k < count; ++k) {
       if ((k == 0 && crack.start_is_tip()) || (k + 1 == count && crack.end_is_tip())) {
         crack.surface(1)[k] = crack.surface(-1)[k] = crack.plane()[k];  // the faces meet at a tip
@@ -375,10 +393,29 @@ void Solver::anchor_crack_surfaces() {
       }
       if (!(mass[0] > 0 && mass[1] > 0)) continue;  // a side with no material here: as it was
       const Vec2 half_jump = 0.5 * (u[0] / mass[0] - u[1] / mass[1]);
-      crack.surface(1)[k] = crack.plane()[k] + half_jump;
-      crack.surface(-1)[k] = crack.plane()[k] - half_jump;
+      if (drift) {
+        velocity[k][0] = rate * (crack.plane()[k] + half_jump - crack.surface(1)[k]);
+        velocity[k][1] = rate * (crack.plane()[k] - half_jump - crack.surface(-1)[k]);
+      } else {
+        crack.surface(1)[k] = crack.plane()[k] + half_jump;
+        crack.surface(-1)[k] = crack.plane()[k] - half_jump;
+      }
     }
   }
+}
+
+double Solver::crack_transit(std::size_t c) const {
+  const Crack& crack = cracks_[c];
+  double slowest = std::numeric_limits<double>::infinity();
+  for (int end = 0; end < 2; ++end) {
+    if (!(end == 0 ? crack.start_is_tip() : crack.end_is_tip())) continue;
+    const std::size_t m = material_at(end == 0 ? crack.plane().front() : crack.plane().back());
+    slowest = std::min(slowest, std::sqrt(shear_[m] / density_[m]));
+  }
+  if (!std::isfinite(slowest)) {  // no tip: the slowest material
+    for (std::size_t m = 0; m < shear_.size(); ++m) slowest = std::min(slowest, std::sqrt(shear_[m] / density_[m]));
+  }
+  return arc_length(crack.plane()).back() / slowest;
 }
 
 void Solver::move_crack_surfaces(double dt) {
@@ -412,10 +449,16 @@ void Solver::move_crack_surfaces(double dt) {
     };
     if (crack.start_is_tip()) close_tip(0);
     if (crack.end_is_tip()) close_tip(count - 1);
+    // With surfaces from the material: the drift toward the material's
+    // opening that anchor_crack_surfaces set for this step.
+    const std::vector<std::array<Vec2, 2>>* drift = nullptr;
+    const std::size_t c = static_cast<std::size_t>(&crack - cracks_.data());
+    if (c < surface_drift_.size() && surface_drift_[c].size() == count) drift = &surface_drift_[c];
     for (int s = 0; s < 2; ++s) {
       auto& surface = crack.surface(s == 0 ? 1 : -1);
       for (std::size_t k = 0; k < count; ++k) {
         if (mass[s][k] > 0) surface[k] += dt * momentum[s][k] / mass[s][k];
+        if (drift) surface[k] += dt * (*drift)[k][static_cast<std::size_t>(s)];
       }
     }
     crack.update_plane();

@@ -101,6 +101,19 @@ struct Fracture {
   // (Solver::anchor_crack_surfaces); false: the surfaces only integrate
   // their fields' velocities.
   bool surfaces_from_material = false;
+  // With surfaces_from_material, the surfaces still move with their fields'
+  // velocities, and relax onto the material's opening with the time constant
+  // surface_relax_transits x L / c_s (L the crack's length, c_s the slowest
+  // shear-wave speed at its tips, with the scaled density): a growth step
+  // re-sorts the nodes about the new segment into two fields, and the
+  // material's opening there jumps by the strain the uncut cell held; set at
+  // once, that jump is a void the stiff fluid at a zero-lag tip cannot fill
+  // in one step (its pressure at the last nodes fell to zero and rose to
+  // 5 times the net pressure, and the kick stalled a toughness-dominated
+  // KGD; docs/solid.md, "Surfaces from the material"). The relaxation is a
+  // drift velocity the face response reports, so the implicit interface
+  // scheme predicts it. 0: set to the material's opening at every step.
+  double surface_relax_transits = 1;
   // After a growth step, the particles using a node the new segment re-sorts
   // into fields take the strain of their fields' nodal displacements (the strain a crack
   // cut there from the start gives them; Solver::reproject_strains). false:

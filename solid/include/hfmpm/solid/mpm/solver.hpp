@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hfmpm/solid/mpm/config.hpp"
@@ -205,6 +206,9 @@ class Solver {
   // (transfer.cpp).
   int reproject_strains(const std::vector<std::array<Vec2, 2>>& segments);
   void anchor_crack_surfaces();
+  // One shear-wave transit of crack c: its length over the slowest
+  // shear-wave speed (scaled density) of the materials at its tips.
+  double crack_transit(std::size_t c) const;
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
@@ -235,6 +239,11 @@ class Solver {
   // s, when the fluid front came within the end tip's allowed lag (-inf: not
   // since its last growth); Fracture::front_settle_transits.
   std::vector<double> front_arrived_at_;
+  double anchored_at_ = -1;  // s, when anchor_crack_surfaces last ran (-1: not yet)
+  // Per crack and crack particle, the drift velocity (m/s) of its surface
+  // above and below toward the material's opening over the step begun
+  // (anchor_crack_surfaces; empty without surfaces_from_material).
+  std::vector<std::vector<std::array<Vec2, 2>>> surface_drift_;
   double feedback_alpha_ = 0;
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
