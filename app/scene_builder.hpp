@@ -36,9 +36,13 @@ double toughness_number(double e_prime, double viscosity, double total_rate, dou
 // What the builder derived (also written into the scene's comments).
 struct Derived {
   double e_prime = 0, km = 0;
-  bool viscosity_dominated = true;  // Km < 1: the M-vertex's closure and checks
-  Vertex end;                       // the regime's vertex at the end (time shifted by half the ramp)
-  double cell = 0;                  // m
+  bool viscosity_dominated = true;  // Km < 1: the M-vertex's checks and settings
+  // Km < 2: the fluid front closed by the viscous tip solution matched to the
+  // fluid (TIP_ASYMPTOTE_MATCHED), else the front's pressure reaches the tip
+  // (FRONT_PRESSURE); 2 is the middle of the transition (Km 1 to 4).
+  bool matched_closure = true;
+  Vertex end;       // the regime's vertex at the end (time shifted by half the ramp)
+  double cell = 0;  // m
   double density_scaling = 1;
   double virtual_opening = 0;  // m
   double damping = 0;          // 1/s, the grid's mass-proportional damping

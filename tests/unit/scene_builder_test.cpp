@@ -199,6 +199,25 @@ TEST(SceneBuilder, EveryProblemOfASweepGivesAValidScene) {
 
 // The builder says where the robustness matrix saw such runs stall or stop:
 // confinement above 50 times the expected net pressure, or below it.
+// Between the vertices the closure is the nearer vertex's, split at Km = 2:
+// the matrix's lab Km = 1 ran 10% long with the toughness closure and within
+// bounds with the matched one, its Km = 10 the other way round (docs/verification.md,
+// "A growth step without a jolt"); the rest stays the toughness regime's.
+TEST(SceneBuilder, TransitionTakesTheClosureOfTheNearerVertex) {
+  problem::Problem p = toughness_problem();
+  p.mutable_rock()->set_toughness_pa_sqrt_m(25e3 * 1.5 / 7.61);  // Km 1.5
+  const BuiltScene near_m = build_scene(p);
+  EXPECT_NEAR(near_m.derived.km, 1.5, 0.01);
+  EXPECT_FALSE(near_m.derived.viscosity_dominated);
+  const scene::Scene s = checked(near_m);
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE_MATCHED);
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e5);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().settle_transits(), 2);
+  EXPECT_TRUE(s.solid().mpm().fracture().surfaces_from_material());
+  p.mutable_rock()->set_toughness_pa_sqrt_m(25e3 * 2.5 / 7.61);  // Km 2.5
+  EXPECT_EQ(checked(build_scene(p)).fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);
+}
+
 TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
   EXPECT_TRUE(build_scene(field_problem()).derived.cautions.empty());  // 15 times
   problem::Problem deep = field_problem();
