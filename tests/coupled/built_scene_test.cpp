@@ -6,10 +6,9 @@
 // lab toughness-dominated one (Km = 7.6); each is built with no setting made
 // for it, at 10 (lab) or 12 (field) cells per expected final half-length (the
 // matrix uses 20) with a notch of two cells, run with water, and compared
-// with the vertex its Km selects from three notch lengths on. Not here, and
-// why (docs/verification.md): the matrix's toughness-dominated field cases
-// and Km = 100 stop with an implicit step that turns a fluid particle inside
-// out; a field case at 5 MPa confinement and 14 cells stalls its tip.
+// with the vertex its Km selects from three notch lengths on. The full matrix
+// (23 of 24 within issue 19's bounds on 5 December; field Km = 100, at ten
+// times its confinement, stalls) is a benchmark, not a test: 1150 s.
 //
 // Bounds, from the runs measured when this test was written (worst over the
 // compared rows; at 10 cells a cell is 10% of the final half-length and the
@@ -18,15 +17,15 @@
 //   (the CI bounds of the hand-built KGD scenes), the fluid front within 20%
 //   (it leads the vertex by about a cell, docs/verification.md "What limits
 //   the KGD length").
-// - The K-vertex case: the front within 20%; opening and pressure within 30%.
-//   After growth steps J reads 0.6-0.7 of K_I^2 / E' (the face-work term
-//   takes the opening from the grown crack's surfaces, which under-read it),
-//   so the tip grows when K_I is 15-20% above K_Ic and opening and pressure
-//   run that much above the vertex (issue 18, docs/verification.md).
-// Measured (3 December; front, opening, pressure, volume balance): lab
-// viscosity 9.3%, 4.0%, 3.1%, 1e-4; field E = 30 GPa 11.8%, 3.2%, 3.1%, 5e-4;
-// field nu = 0.15 8.8%, 6.7%, 8.5%, 2.6e-3; lab toughness 7.1%, 21.9%, 25.8%,
-// 6e-4. 42 s for the four, two at a time.
+// - The K-vertex case: the same bounds since the faces are read from the
+//   material, relaxed over a transit, with damping critical for the crack's
+//   mode (5 December, docs/verification.md "A growth step without a jolt";
+//   30% on opening and pressure before, when the velocity faces read the
+//   grown part narrow: 21.9% and 25.8%).
+// Measured (5 December; front, opening, pressure, volume balance): lab
+// viscosity 3.6%, 5.1%, 8.1%, 1e-4; field E = 30 GPa 3.9%, 4.8%, 7.7%, 5e-4;
+// field nu = 0.15 4.0%, 5.0%, 7.3%, 5e-4; lab toughness 4.5%, 8.4%, 16.2%,
+// 1e-4. 36 s for the four, two at a time.
 // - Every case: the water's volume (sum of l w) is the injected volume plus
 //   the notch's virtual film within 2% once the crack is three notch lengths
 //   long, and the run completes.
@@ -100,7 +99,7 @@ Outcome run_case(const Case& c) {
 void check(const Outcome& o) {
   SCOPED_TRACE(o.name);
   ASSERT_EQ(o.result.exit_code, 0) << o.result.err;
-  const double opening_bound = o.viscous ? 0.10 : 0.30, pressure_bound = o.viscous ? 0.20 : 0.30;
+  const double opening_bound = 0.10, pressure_bound = 0.20;
   int compared = 0;
   double worst[4] = {0, 0, 0, 0};
   for (std::size_t i = 0; i < o.t.size(); ++i) {
