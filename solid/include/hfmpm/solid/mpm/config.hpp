@@ -96,9 +96,10 @@ struct Fracture {
   // its direction are read on the field the front's pressure has made.
   // 0: grows at the first check.
   double front_settle_transits = 4;
-  // At the start of every step, set the crack surfaces about the plane with
-  // the material's opening, the jump of its displacement across the crack
-  // (Solver::anchor_crack_surfaces); false: the surfaces only integrate
+  // The crack surfaces follow the material's opening, the jump of its
+  // displacement across the crack: set to it at the first step, then moved
+  // by their fields' velocities plus a drift toward it (below;
+  // Solver::anchor_crack_surfaces); false: the surfaces only integrate
   // their fields' velocities.
   bool surfaces_from_material = false;
   // With surfaces_from_material, the surfaces still move with their fields'
