@@ -44,8 +44,8 @@ std::vector<double> predicted(const Solver& s, const std::vector<double>& p, dou
   return w;
 }
 
-TEST(FaceResponse, PredictsTheOpeningOfTheNextStepForAnyPressure) {
-  Solver s(opened_edge_crack());
+void expect_exact_prediction(const SolidConfig& config) {
+  Solver s(config);
   const std::size_t n = s.cracks()[0].size();
   // Open the crack and leave it moving: a few steps under 1 MPa.
   s.set_crack_pressure(0, std::vector<double>(n, 1e6));
@@ -73,6 +73,18 @@ TEST(FaceResponse, PredictsTheOpeningOfTheNextStepForAnyPressure) {
     std::printf("variant %d: opening change %.3e m, prediction error %.3e m\n", variant, change, error);
     EXPECT_LT(error, 1e-9 * change) << "pressure variant " << variant << ": change " << change;
   }
+}
+
+TEST(FaceResponse, PredictsTheOpeningOfTheNextStepForAnyPressure) { expect_exact_prediction(opened_edge_crack()); }
+
+// With the surfaces read from the material they drift toward its opening
+// over the step (Fracture::surface_relax_transits); face_response reports the
+// drift with the opening rate, so the prediction stays exact. Reporting it
+// it not (checked by hand) left errors of 0.7-1.3% of the opening change.
+TEST(FaceResponse, PredictsTheOpeningWithTheSurfacesDriftingToTheMaterial) {
+  SolidConfig c = opened_edge_crack();
+  c.fracture.surfaces_from_material = true;
+  expect_exact_prediction(c);
 }
 
 TEST(FaceResponse, IsBandedAndSplittingTheStepChangesNothing) {

@@ -1,6 +1,7 @@
 // The crack parts of the MPM step (CRAMP): which velocity field a
-// particle-node pair uses, crack-face pressure into each side's field, and
-// the crack surfaces moved by their own side's field.
+// particle-node pair uses, crack-face pressure into each side's field, the
+// faces' one-step response, the implicit face stiffness and contact. Where
+// the crack surfaces are: crack_surfaces.cpp.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,30 +12,11 @@
 #include "hfmpm/solid/mpm/predicates.hpp"
 #include "hfmpm/solid/mpm/shape.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
+#include "side_nodes.hpp"
 
 namespace hfmpm::solid::mpm {
-namespace {
 
-// The 4 nodes of the cell holding x and their linear weights.
-struct CellWeights {
-  int i = 0, j = 0;
-  double w[2][2] = {{0, 0}, {0, 0}};  // [a][b] for node (i + a, j + b)
-};
-
-CellWeights cell_weights(const Grid& g, const Vec2& x) {
-  CellWeights c;
-  const Vec2 rel = (x - g.origin) / g.h;
-  c.i = static_cast<int>(std::floor(rel.x()));
-  c.j = static_cast<int>(std::floor(rel.y()));
-  const double fx = rel.x() - c.i, fy = rel.y() - c.j;
-  c.w[0][0] = (1 - fx) * (1 - fy);
-  c.w[1][0] = fx * (1 - fy);
-  c.w[0][1] = (1 - fx) * fy;
-  c.w[1][1] = fx * fy;
-  return c;
-}
-
-}  // namespace
+using detail::for_side_nodes;
 
 int Solver::field_of(const Vec2& from, const Vec2& node) const {
   bool odd = false;
@@ -42,37 +24,6 @@ int Solver::field_of(const Vec2& from, const Vec2& node) const {
     if (crack.crosses(from, node)) odd = !odd;  // an even number of crossings cancels
   }
   return odd ? 1 : 0;
-}
-
-// For side `side` (+1 above, -1 below) of crack particle k: the nodes around
-// the surface point, the field that side uses at each, and linear weights
-// over the nodes where that field has mass (renormalized).
-template <class Visit>
-void for_side_nodes(const Solver& solver, const Grid& g, const NodalFields* fields[2], const Crack& crack,
-                    std::size_t k, int side, double min_mass, Visit&& visit) {
-  const Vec2 n = crack.normal(k);
-  const Vec2 test = crack.plane()[k] + side * 1e-6 * g.h * n;  // a point just off the plane on that side
-  // The cell of the surface point nudged to its own side: a closed surface on
-  // a grid line would otherwise take the cell above for both sides.
-  const auto cell = cell_weights(g, crack.surface(side)[k] + side * 1e-6 * g.h * n);
-  int node[4], field[4];
-  double weight[4], total = 0;
-  int count = 0;
-  for (int a = 0; a < 2; ++a) {
-    for (int b = 0; b < 2; ++b) {
-      if (!g.inside(cell.i + a, cell.j + b)) continue;
-      const int nd = g.node(cell.i + a, cell.j + b);
-      const int f = solver.field_of(test, g.position(nd));
-      const double w = cell.w[a][b];
-      if (w <= 0 || fields[f]->mass[static_cast<std::size_t>(nd)] <= min_mass) continue;
-      node[count] = nd;
-      field[count] = f;
-      weight[count] = w;
-      total += w;
-      ++count;
-    }
-  }
-  for (int c = 0; c < count; ++c) visit(node[c], field[c], weight[c] / total);
 }
 
 void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
@@ -185,6 +136,7 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
     double weight;  // signed: + above, - below
   };
   std::vector<std::vector<Read>> reads(count);
+  const auto* drift = surface_drift(c);  // the surfaces' drift toward the material this step, if any
   for (std::size_t k = 0; k < count; ++k) {
     const Vec2 n = crack.normal(k);
     double side_mass[2] = {0, 0};
@@ -212,9 +164,7 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
       side_a[s] = a_sum / mass;
       if (tip(k)) continue;  // both surfaces of a tip move together: no opening
       out.rate[k] += side * v_sum.dot(n) / mass;
-      if (c < surface_drift_.size() && surface_drift_[c].size() == count) {
-        out.rate[k] += side * surface_drift_[c][k][static_cast<std::size_t>(s)].dot(n);  // anchor_crack_surfaces
-      }
+      if (drift) out.rate[k] += side * (*drift)[k][static_cast<std::size_t>(s)].dot(n);  // anchor_crack_surfaces
       out.acceleration[k] += side * a_sum.dot(n) / mass;
       for (auto& r : mine) reads[k].push_back({r.key, side * r.weight / mass});
     }
@@ -333,141 +283,6 @@ void Solver::implicit_face_stiffness(double dt) {
     keep_fixed(u, fb);
   }
 }
-
-// The crack surfaces at the start of a step, read from the material: at each
-// crack particle the opening is the jump of the displacement across the
-// crack, u_above - u_below, each side's displacement the mass-weighted mean
-// of its field at the nodes around the surface point (the same nodes and
-// weights as the velocity update), taken to the nodes with the particles'
-// own gradients (affine_displacement). The displacement is since the start,
-// when the body was whole where the crack is now, so the jump is the whole
-// opening. The surfaces are set about the plane, which does not move: the
-// fields and the contact test of this step were sorted against it. Within
-// the step the surfaces move with their fields' velocities
-// (move_crack_surfaces), which face_response predicts exactly.
-//
-// Why not only the velocities: a surface made at a growing tip integrates its
-// side's velocity from the moment it is made, and while the nodes around it
-// still hold one field for both sides (the crack has not yet cut their lines
-// to the particles beyond) both surfaces move alike and the opening the
-// material makes then is never read. A crack grown under load read 0.65-0.82
-// of the opening of a crack cut at that length, in proportion to the load it
-// grew under, while the material beside it opened 0.86-0.96 (the edge-crack
-// comparison, docs/verification.md "The grown crack"); read from the
-// material, 0.96-1.00. The particles' displacement carries what a surface
-// missed, which is read as soon as its fields part.
-void Solver::anchor_crack_surfaces() {
-  const auto& g = config_.grid;
-  const NodalFields* fields[2] = {&field0_, &field1_};
-  affine_displacement();
-  // The relaxation is a drift velocity the surfaces add to their fields'
-  // over the coming step (move_crack_surfaces), and face_response reports it
-  // with the faces' opening rate, so the fluid's implicit solve sees it
-  // coming. Over the last step's length dt it closes the fraction
-  // 1 - exp(-dt / tau) of the gap: (target - surface) (1 - exp(-dt / tau)) / dt.
-  // The first anchoring, and tau = 0, set the surfaces outright.
-  const double elapsed = anchored_at_ >= 0 ? t_ - anchored_at_ : -1;
-  anchored_at_ = t_;
-  surface_drift_.resize(cracks_.size());
-  for (std::size_t c = 0; c < cracks_.size(); ++c) {
-    auto& crack = cracks_[c];
-    const double tau = config_.fracture.surface_relax_transits * crack_transit(c);
-    const bool drift = elapsed > 0 && tau > 0;
-    const double rate = drift ? -std::expm1(-elapsed / tau) / elapsed : 0.0;  // 1/s
-    const std::size_t count = crack.size();
-    auto& velocity = surface_drift_[c];
-    velocity.assign(count, {Vec2::Zero(), Vec2::Zero()});
-    for (std::size_t k = 0; k < count; ++k) {
-      if ((k == 0 && crack.start_is_tip()) || (k + 1 == count && crack.end_is_tip())) {
-        crack.surface(1)[k] = crack.surface(-1)[k] = crack.plane()[k];  // the faces meet at a tip
-        continue;
-      }
-      Vec2 u[2] = {Vec2::Zero(), Vec2::Zero()};
-      double mass[2] = {0, 0};
-      for (int s = 0; s < 2; ++s) {
-        for_side_nodes(*this, g, fields, crack, k, s == 0 ? 1 : -1, min_mass_, [&](int nd, int f, double w) {
-          const auto n = static_cast<std::size_t>(nd);
-          mass[s] += w * fields[f]->mass[n];
-          u[s] += w * affine_[static_cast<std::size_t>(f)][n];
-        });
-      }
-      if (!(mass[0] > 0 && mass[1] > 0)) continue;  // a side with no material here: as it was
-      const Vec2 half_jump = 0.5 * (u[0] / mass[0] - u[1] / mass[1]);
-      if (drift) {
-        velocity[k][0] = rate * (crack.plane()[k] + half_jump - crack.surface(1)[k]);
-        velocity[k][1] = rate * (crack.plane()[k] - half_jump - crack.surface(-1)[k]);
-      } else {
-        crack.surface(1)[k] = crack.plane()[k] + half_jump;
-        crack.surface(-1)[k] = crack.plane()[k] - half_jump;
-      }
-    }
-  }
-}
-
-double Solver::crack_transit(std::size_t c) const {
-  const Crack& crack = cracks_[c];
-  double slowest = std::numeric_limits<double>::infinity();
-  for (int end = 0; end < 2; ++end) {
-    if (!(end == 0 ? crack.start_is_tip() : crack.end_is_tip())) continue;
-    const std::size_t m = material_at(end == 0 ? crack.plane().front() : crack.plane().back());
-    slowest = std::min(slowest, std::sqrt(shear_[m] / density_[m]));
-  }
-  if (!std::isfinite(slowest)) {  // no tip: the slowest material
-    for (std::size_t m = 0; m < shear_.size(); ++m) slowest = std::min(slowest, std::sqrt(shear_[m] / density_[m]));
-  }
-  return arc_length(crack.plane()).back() / slowest;
-}
-
-void Solver::move_crack_surfaces(double dt) {
-  const auto& g = config_.grid;
-  const NodalFields* fields[2] = {&field0_, &field1_};
-  for (auto& crack : cracks_) {
-    const std::size_t count = crack.size();
-    std::vector<Vec2> momentum[2];
-    std::vector<double> mass[2];
-    for (int s = 0; s < 2; ++s) {
-      const int side = s == 0 ? 1 : -1;
-      momentum[s].assign(count, Vec2::Zero());
-      mass[s].assign(count, 0.0);
-      for (std::size_t k = 0; k < count; ++k) {
-        // Mass-weighted velocity of the side's own field.
-        for_side_nodes(*this, g, fields, crack, k, side, min_mass_, [&](int nd, int f, double w) {
-          const double m = fields[f]->mass[static_cast<std::size_t>(nd)];
-          mass[s][k] += w * m;
-          momentum[s][k] += w * m * velocity_[f][static_cast<std::size_t>(nd)];
-        });
-      }
-    }
-    // The faces meet at a tip: both surfaces of a tip particle move together.
-    auto close_tip = [&](std::size_t k) {
-      const double m = mass[0][k] + mass[1][k];
-      const Vec2 p = momentum[0][k] + momentum[1][k];
-      for (int s = 0; s < 2; ++s) {
-        momentum[s][k] = p;
-        mass[s][k] = m;
-      }
-    };
-    if (crack.start_is_tip()) close_tip(0);
-    if (crack.end_is_tip()) close_tip(count - 1);
-    // With surfaces from the material: the drift toward the material's
-    // opening that anchor_crack_surfaces set for this step.
-    const std::vector<std::array<Vec2, 2>>* drift = nullptr;
-    const std::size_t c = static_cast<std::size_t>(&crack - cracks_.data());
-    if (c < surface_drift_.size() && surface_drift_[c].size() == count) drift = &surface_drift_[c];
-    for (int s = 0; s < 2; ++s) {
-      auto& surface = crack.surface(s == 0 ? 1 : -1);
-      for (std::size_t k = 0; k < count; ++k) {
-        if (mass[s][k] > 0) surface[k] += dt * momentum[s][k] / mass[s][k];
-        if (drift) surface[k] += dt * (*drift)[k][static_cast<std::size_t>(s)];
-      }
-    }
-    crack.update_plane();
-  }
-}
-
-}  // namespace hfmpm::solid::mpm
-
-namespace hfmpm::solid::mpm {
 
 // Contact (Nairn 2003, section 2.3): where a node has both fields, the crack
 // surfaces there are in contact if the displacement-based opening along the

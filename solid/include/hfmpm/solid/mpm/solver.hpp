@@ -209,6 +209,9 @@ class Solver {
   // One shear-wave transit of crack c: its length over the slowest
   // shear-wave speed (scaled density) of the materials at its tips.
   double crack_transit(std::size_t c) const;
+  // Crack c's surface drift for the step begun, or nullptr if it has none
+  // (no surfaces_from_material, or the crack changed since it was set).
+  const std::vector<std::array<Vec2, 2>>* surface_drift(std::size_t c) const;
   void move_crack_surfaces(double dt);
   // Frictionless contact between the two fields of a node; dt = 0: on the
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
