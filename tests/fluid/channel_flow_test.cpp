@@ -25,12 +25,25 @@
 //    width tapers linearly to zero at the tip (the fluid front) stays at
 //    rest: the force p dw/ds of the inclined faces balances -d(p w)/ds. Checked
 //    to round-off.
-// 3. No tension: crack faces pulled apart quickly (width doubling in a few
+// 3. A widening channel: the faces of a channel of length L closed at its far
+//    end part at a uniform rate dw/dt, and a pressure inlet fills it. The
+//    fluid must bring the new volume in, so its velocity is linear along the
+//    channel, v = alpha (L - s), alpha = (dw/dt) / w, and the momentum balance
+//    rho (dv/dt + v dv/ds) = -dp/ds - 12 mu v / w^2 (alpha' = -alpha^2) gives
+//    p(s) = p_in + C (L s - s^2 / 2), C = 2 rho alpha^2 - 12 mu alpha / w^2.
+//    A linear velocity is what plain PIC averages away at every step: a loss
+//    per step, which acts as a drag of order 1 / dt and, at the steps here,
+//    puts the closed end's pressure 30-60% of the drop off (and more the
+//    smaller the step). With the affine transfer (APIC) the profile is
+//    asserted within 2% of the drop at two steps (the rest: the inlet
+//    particle's split cycle and the transient), and PIC is checked to miss it.
+// 4. No tension: crack faces pulled apart quickly (width doubling in a few
 //    steps) leave every particle and nodal pressure >= 0.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "channel.hpp"
 #include "hfmpm/fluid/mpm/solver.hpp"
@@ -226,6 +239,66 @@ TEST(Equilibrium, UniformPressureInATaperingCrackStaysAtRest) {
   EXPECT_LT(vmax, 1e-9);
   EXPECT_LT(pdev, 1e-9);
   EXPECT_NEAR(fluid.fluid_mass(), mass, 1e-13 * mass);
+}
+
+// The worst |p_i - p(s_i)| over the nodes, as a fraction of the exact drop
+// p_in - p(L), at t_end in a channel widening from w0 at dw/dt.
+double widening_channel_error(bool affine, double cfl, double rho, int cells = 20) {
+  const double L = 1.0, w0 = 1e-3, rate = 1e-3, mu = 0.01, p_in = 2e5, t_end = 0.1;
+  FluidConfig c;
+  c.density = rho;
+  c.bulk_modulus = 2e8;
+  c.viscosity = mu;
+  c.cfl = cfl;
+  c.affine = affine;
+  c.inlet.kind = InletConfig::Kind::Pressure;
+  c.inlet.pressure = TimeFunction::constant(p_in);
+  FluidSolver fluid(c);
+  const auto s = test::uniform_nodes(L, cells);
+  fluid.set_crack(test::straight_crack(s, std::vector<double>(s.size(), w0)));
+  fluid.fill(L, p_in);
+  double t = 0;
+  while (t < t_end - 1e-12) {
+    const double dt = std::min(fluid.stable_dt(), t_end - t);
+    fluid.step(dt);
+    t += dt;
+    fluid.set_crack(test::straight_crack(s, std::vector<double>(s.size(), w0 + rate * t)));
+  }
+  const double w = w0 + rate * t, alpha = rate / w;
+  const double C = 2 * rho * alpha * alpha - 12 * mu * alpha / (w * w);
+  const double drop = -C * L * L / 2;
+  double worst = 0;
+  for (std::size_t i = 1; i + 1 < s.size(); ++i) {  // the closed end's node carries the lag rule's 0
+    const double exact = p_in + C * (L * s[i] - 0.5 * s[i] * s[i]);
+    worst = std::max(worst, std::abs(fluid.nodal_pressure()[i] - exact) / drop);
+  }
+  return worst;
+}
+
+TEST(WideningChannel, LinearInflowKeepsItsMomentumUnderTheAffineTransfer) {
+  // A light fluid (rho = 100: the inertial terms are 0.2% of the drop): the
+  // transfer alone. Measured 0.32% at 20 cells, 0.21% at 40, 0.08% at 80.
+  const double apic = widening_channel_error(true, 0.5, 100), apic_half = widening_channel_error(true, 0.25, 100);
+  const double pic = widening_channel_error(false, 0.5, 100), pic_half = widening_channel_error(false, 0.25, 100);
+  const double finer = widening_channel_error(true, 0.5, 100, 40);
+  std::printf(
+      "widening channel, rho = 100, worst nodal pressure error / drop: APIC %.4f (cfl 0.5), %.4f (0.25), "
+      "%.4f (40 cells); PIC %.4f, %.4f\n",
+      apic, apic_half, finer, pic, pic_half);
+  EXPECT_LT(apic, 0.01);
+  EXPECT_LT(apic_half, 0.01);
+  EXPECT_LT(finer, apic);
+  EXPECT_GT(pic, 10 * apic);       // the per-step loss the affine transfer removes,
+  EXPECT_GT(pic_half, 1.5 * pic);  // which grows as the step shrinks
+  // Water's density (the inertial terms 1.8% of the drop): measured 3.5% at
+  // 20 cells, 3.3% at 40, 3.7% at 80, the same at half the step (and 3.3%
+  // with the faces parting exponentially, alpha constant, where inertia is
+  // 1.0% of the drop): the closed end's pressure stands above the exact one,
+  // as if the inertial terms counted three to four times. Not explained;
+  // held here so that it does not grow.
+  const double water = widening_channel_error(true, 0.5, 1000);
+  std::printf("widening channel, rho = 1000: APIC %.4f\n", water);
+  EXPECT_LT(water, 0.05);
 }
 
 TEST(NoTension, FacesPulledApartGiveNoNegativePressure) {

@@ -12,7 +12,8 @@
 // Compared at t = 1000 tau (telegraph corrections ~ tau / t = 1e-3), in a
 // channel 4 diffusion lengths long (erfc(4) = 2e-8: the far end does not
 // matter). Asserted: max nodal error < 2% of p0 at every resolution, falling
-// under refinement; injected volume within 2%.
+// under refinement, and below 5e-4 and 2e-4 of p0 at the coarsest and finer
+// resolutions (below); injected volume within 2%, its error falling.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -58,7 +59,7 @@ DiffusionResult diffusion(int cells) {
 }
 
 TEST(PressureDiffusion, MatchesErfcAndConverges) {
-  double previous = 1;
+  double previous = 1, previous_volume = 1;
   for (int cells : {50, 100, 200}) {
     const auto r = diffusion(cells);
     std::printf("pressure diffusion: %d cells (%d steps), max nodal error %.3e of p0, injected volume error %+.3e\n",
@@ -66,14 +67,17 @@ TEST(PressureDiffusion, MatchesErfcAndConverges) {
     EXPECT_LT(r.max_error, 0.02);
     EXPECT_LT(std::abs(r.volume_error), 0.02);
     EXPECT_LT(r.max_error, previous);
+    // With the affine transfer (APIC) the error is 2.1e-4, 1.5e-4 and
+    // 1.4e-4 of p0 at 50, 100 and 200 cells: at the coarsest already near
+    // the size of the telegraph correction the erfc leaves out (tau / t =
+    // 1e-3 of the solution's scale), towards which it falls. Under plain PIC
+    // it was 9.0e-4, 3.8e-4 and 1.6e-4 (order 1.25, 1.23): PIC's per-step
+    // smoothing of the velocity, first order in h with dt proportional to h.
+    EXPECT_LT(r.max_error, cells == 50 ? 5e-4 : 2e-4);
     if (cells > 50) {
-      // Observed order log2(e(2h) / e(h)) with dt proportional to h (the
-      // acoustic step): at least first order (measured 1.25 and 1.23 for
-      // 50 -> 100 -> 200 cells); held above 0.9.
-      const double order = std::log2(previous / r.max_error);
-      std::printf("pressure diffusion: observed order %.2f\n", order);
-      EXPECT_GT(order, 0.9);
+      EXPECT_LT(std::abs(r.volume_error), std::abs(previous_volume));
     }
+    previous_volume = r.volume_error;
     previous = r.max_error;
   }
 }

@@ -14,6 +14,7 @@ void CrackGrid::save(StateWriter& out) const {
   out.put("arc", arc_);
   out.put("width", width_);
   out.put("crack_width", crack_width_);
+  out.put("extra", extra_);
   out.put("min_spacing", min_spacing_);
   out.put("appended", appended_);
 }
@@ -25,10 +26,12 @@ void CrackGrid::load(const StateReader& in) {
   in.get("arc", arc_);
   in.get("width", width_);
   in.get("crack_width", crack_width_);
+  in.get("extra", extra_);
   in.get("min_spacing", min_spacing_);
   in.get("appended", appended_);
   const std::size_t n = ids_.size();
-  if (position_.size() != n || arc_.size() != n || width_.size() != n || crack_width_.size() != n) {
+  if (position_.size() != n || arc_.size() != n || width_.size() != n || crack_width_.size() != n ||
+      extra_.size() != n) {
     throw std::runtime_error("checkpoint: the fluid's crack grid arrays differ in size");
   }
 }
@@ -42,6 +45,7 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("particles.width", P.width);
   out.put("particles.mass", P.mass);
   out.put("particles.velocity", P.velocity);
+  out.put("particles.gradient", P.gradient);
   out.put("particles.f11", P.f11);
   out.put("particles.f22", P.f22);
   out.put("particles.w0", P.w0);
@@ -55,6 +59,7 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("shapes.count", count);
   out.put("shapes.offset", shapes_.offset);
   out.put("shapes.weight", shapes_.weight);
+  out.put("shapes.gradient", shapes_.gradient);
   out.put("nodes.mass", mass_);
   out.put("nodes.momentum", momentum_);
   out.put("nodes.drag", drag_);
@@ -113,11 +118,13 @@ void FluidSolver::load(const StateReader& in) {
   in.get("particles.width", P.width);
   in.get("particles.mass", P.mass);
   in.get("particles.velocity", P.velocity);
+  in.get("particles.gradient", P.gradient);
   in.get("particles.f11", P.f11);
   in.get("particles.f22", P.f22);
   in.get("particles.w0", P.w0);
   in.get("particles.pressure", P.pressure);
-  for (const auto* field : {&P.length, &P.width, &P.mass, &P.velocity, &P.f11, &P.f22, &P.w0, &P.pressure}) {
+  for (const auto* field :
+       {&P.length, &P.width, &P.mass, &P.velocity, &P.gradient, &P.f11, &P.f22, &P.w0, &P.pressure}) {
     if (field->size() != P.s.size()) throw std::runtime_error("checkpoint: the fluid particles' arrays differ in size");
   }
   std::vector<std::uint64_t> first, count;
@@ -128,6 +135,7 @@ void FluidSolver::load(const StateReader& in) {
   for (std::size_t p = 0; p < first.size(); ++p) shapes_.range[p] = {first[p], count[p]};
   in.get("shapes.offset", shapes_.offset);
   in.get("shapes.weight", shapes_.weight);
+  in.get("shapes.gradient", shapes_.gradient);
   in.get("nodes.mass", mass_);
   in.get("nodes.momentum", momentum_);
   in.get("nodes.drag", drag_);

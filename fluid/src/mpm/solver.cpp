@@ -281,14 +281,24 @@ void FluidSolver::p2g() {
   drag_k_.resize(np);
   for (std::size_t p = 0; p < np; ++p) widths_floor_[p] = std::max(P.width[p], config_.min_width);
   rheology_->drag(widths_floor_, P.velocity, drag_k_);
+  const bool affine = config_.affine;
   for (std::size_t p = 0; p < np; ++p) {
     const CpdiRange r = shapes_.range[p];
     const double* N = shapes_.weight.data() + shapes_.offset[p];
     const double m = P.mass[p], mv = m * P.velocity[p];
     const double c = drag_k_[p] * P.length[p] * widths_floor_[p];  // N s/m^2: friction = -c v
+    // APIC: node i gets m N_ip (v_p + g_p (s_i - sbar_p)), sbar_p = sum_i
+    // N_ip s_i (the domain's centre, s_p inside the grid): the affine part
+    // carries no net momentum, and a linear velocity field reaches every
+    // node, the ends included, exactly.
+    double centre = 0;
+    if (affine) {
+      for (std::size_t k = 0; k < r.count; ++k) centre += N[k] * arc[r.first + k];
+    }
+    const double mg = affine ? m * P.gradient[p] : 0.0;
     for (std::size_t k = 0; k < r.count; ++k) {
       mass_[r.first + k] += N[k] * m;
-      momentum_[r.first + k] += N[k] * mv;
+      momentum_[r.first + k] += N[k] * (mv + mg * (arc[r.first + k] - centre));
       drag_[r.first + k] += N[k] * c;
     }
     // Pressure force p_p [w N_i] from a_p to b_p (see solver.hpp).
@@ -353,12 +363,15 @@ void FluidSolver::g2p(double dt) {
   for (std::size_t p = 0; p < P.size(); ++p) {
     const CpdiRange r = shapes_.range[p];
     const double* N = shapes_.weight.data() + shapes_.offset[p];
-    double pic = 0, change = 0;
+    const double* G = shapes_.gradient.data() + shapes_.offset[p];
+    double pic = 0, change = 0, gradient = 0;
     for (std::size_t k = 0; k < r.count; ++k) {
       pic += N[k] * v_new_[r.first + k];
       change += N[k] * (v_new_[r.first + k] - v_old_[r.first + k]);
+      gradient += G[k] * v_new_[r.first + k];
     }
     P.velocity[p] = (1 - flip) * pic + flip * (P.velocity[p] + change);
+    P.gradient[p] = config_.affine ? gradient : 0.0;  // the mean of dv/ds over the domain
     // CPDI corner update: both ends move with the grid velocity there.
     const double a = P.start(p) + dt * interpolate(arc, v_new_, P.start(p));
     const double b = moved_end(p + 1 == P.size(), P.end(p), a, P.end(p) + dt * interpolate(arc, v_new_, P.end(p)), arc,

@@ -56,6 +56,16 @@ struct FluidConfig {
   // otherwise set the fluid's stable step. 0: never; < 2 (the split length).
   double merge_fraction = 0;
   double flip = 0;  // -, FLIP fraction of the particle velocity update (0 = PIC)
+  // Affine particle-in-cell (APIC; Jiang et al. 2015, reduced to the 1D
+  // CPDI domain): each particle also carries its velocity gradient, taken
+  // from the grid with the velocity and given back with it, so that a
+  // velocity varying linearly along the crack goes to the grid and back
+  // unchanged. Plain PIC averages that variation away at every step: a loss
+  // per step, not per second, which throttled a pressure inlet's inflow in
+  // proportion to the step (layered-ci's mouth opening at 0.5 s was 4.2e-5,
+  // 3.3e-5, 2.4e-5 and 1.5e-5 m at 0.9, 0.45, 0.225 and 0.1 of the step;
+  // docs/fluid.md, "Particle-grid transfer"). false: PIC (with `flip`).
+  bool affine = true;
   // Pressure constant per element, from the volume ratio of the fluid in it
   // (against volumetric locking, see FluidSolver::element_pressure); false:
   // each particle's pressure from its own J = F11 F22.

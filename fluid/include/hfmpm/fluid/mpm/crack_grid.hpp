@@ -26,8 +26,10 @@ class CrackGrid {
   // fewer than 2 crack particles, arrays of different sizes, a non-finite or
   // negative width, coincident crack particles, a different crack id, or ids
   // that were reordered or removed.
-  // Nodes with arc length <= pre_opening_length (m; always node 0) are
-  // pre_opening (m) wider for the fluid than the crack: a virtual opening
+  // Nodes with arc length <= pre_opening_length (m; always node 0) when they
+  // first appear are pre_opening (m) wider for the fluid than the crack, for
+  // as long as they exist (the crack's stretching does not move a node out
+  // of it): a virtual opening
   // that lets fluid enter a closed mouth. It is added (not a floor) so that
   // the fluid's width always follows the crack's: under a floor the fluid
   // sits in a rigid virtual channel until the crack opens past it, its
@@ -71,6 +73,7 @@ class CrackGrid {
   std::vector<std::uint64_t> ids_;
   std::vector<Vec2> position_;
   std::vector<double> arc_, width_, crack_width_;
+  std::vector<double> extra_;  // m, each node's virtual and pre-opening, fixed when it first appears
   double min_spacing_ = 0;
   std::size_t appended_ = 0;
 };

@@ -25,6 +25,9 @@ struct FluidParticles {
   std::vector<double> width;     // m, w, mean crack width over [s - l/2, s + l/2]
   std::vector<double> mass;      // kg/m, per unit thickness
   std::vector<double> velocity;  // m/s, mean over the cross-section, along +s
+  // 1/s, dv/ds: the affine part of the particle's velocity field (APIC;
+  // FluidConfig::affine), v(s) = velocity + gradient (s - s_p) over its domain.
+  std::vector<double> gradient;
   std::vector<double> f11;       // -, stretch along the crack
   std::vector<double> f22;       // -, w / w0
   std::vector<double> w0;        // m, width on entry (> 0: floored at the solver's min_width)
@@ -55,8 +58,8 @@ struct FluidParticles {
   }
 
  private:
-  std::array<std::vector<double>*, 9> fields() {
-    return {&s, &length, &width, &mass, &velocity, &f11, &f22, &w0, &pressure};
+  std::array<std::vector<double>*, 10> fields() {
+    return {&s, &length, &width, &mass, &velocity, &gradient, &f11, &f22, &w0, &pressure};
   }
 };
 

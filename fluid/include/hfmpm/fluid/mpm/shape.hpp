@@ -57,15 +57,17 @@ struct ShapeTable {
   std::vector<CpdiRange> range;     // per particle
   std::vector<std::size_t> offset;  // per particle: index of its first weight
   std::vector<double> weight;       // flat: Nbar_ip
+  std::vector<double> gradient;     // flat: Gbar_ip, 1/m
 
   void clear() {
     range.clear();
     offset.clear();
     weight.clear();
+    gradient.clear();
   }
   void add(std::span<const double> nodes, double a, double b) {
     offset.push_back(weight.size());
-    range.push_back(cpdi_weights(nodes, a, b, weight));
+    range.push_back(cpdi_weights(nodes, a, b, weight, &gradient));
   }
 };
 
