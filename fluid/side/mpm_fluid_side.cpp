@@ -274,6 +274,7 @@ mpm::FluidConfig to_fluid_config(const scene::Scene& scene) {
   c.particle_length = f.particle_length_m();
   c.merge_fraction = f.merge_fraction();
   c.flip = f.flip_fraction();
+  c.affine = f.affine_transfer();
   c.smooth_jacobian = f.element_pressure();
   c.min_width = f.min_width_m();
   const auto& in = f.inlet();

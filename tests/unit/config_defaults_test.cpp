@@ -226,6 +226,7 @@ Keys<FluidConfig> mpm_fluid_keys() {
            {"particle_length_m", [](const FluidConfig& c) { return c.particle_length; }},
            {"merge_fraction", [](const FluidConfig& c) { return c.merge_fraction; }},
            {"flip_fraction", [](const FluidConfig& c) { return c.flip; }},
+           {"affine_transfer", [](const FluidConfig& c) { return c.affine ? 1 : 0; }},
            {"element_pressure", [](const FluidConfig& c) { return c.smooth_jacobian ? 1 : 0; }},
            {"min_width_m", [](const FluidConfig& c) { return c.min_width; }},
            {"virtual_opening_m", [](const FluidConfig& c) { return c.virtual_opening; }},

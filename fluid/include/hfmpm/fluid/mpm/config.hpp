@@ -64,7 +64,8 @@ struct FluidConfig {
   // per step, not per second, which throttled a pressure inlet's inflow in
   // proportion to the step (layered-ci's mouth opening at 0.5 s was 4.2e-5,
   // 3.3e-5, 2.4e-5 and 1.5e-5 m at 0.9, 0.45, 0.225 and 0.1 of the step;
-  // docs/fluid.md, "Particle-grid transfer"). false: PIC (with `flip`).
+  // docs/fluid.md, "Particle-grid transfer"). false: PIC (with `flip`). Scene key
+  // fluid.mpm.affine_transfer.
   bool affine = true;
   // Pressure constant per element, from the volume ratio of the fluid in it
   // (against volumetric locking, see FluidSolver::element_pressure); false:
