@@ -114,6 +114,12 @@ void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelop
          std::to_string(hello.pid()));
     return;
   }
+  if (envelope.has_hello() && envelope.hello().role() == side.role && !side.ready) {
+    // A side repeats its Hello until it has its Welcome (the first can be
+    // lost on a refused connection); the Welcome is on its way.
+    if (side.repeated_hellos++ == 0) log_(side.name + " side: a repeated Hello ignored (it has joined)");
+    return;
+  }
   if (envelope.has_listening() && side.role == protocol::SOLID && side.data_endpoint.empty()) {
     side.data_endpoint = envelope.listening().data_endpoint();
     manifest_.set("data_endpoint", side.data_endpoint);

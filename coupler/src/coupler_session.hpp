@@ -57,6 +57,7 @@ struct Side {
   std::string name;  // routing id: "solid" or "fluid"
   bool expected = false;
   bool joined = false;
+  int repeated_hellos = 0;  // Hellos after the first (a side repeats it until Welcome), ignored
   bool ready = false;
   bool stopping = false;
   std::string implementation;

@@ -40,6 +40,9 @@ int side_main(int argc, char** argv, protocol::Role role, const std::string& imp
   app.add_option("--fault", fault, "test hook: exit|crash|hang|freeze|garbage|nan at STEP")->type_name("KIND@STEP");
   app.add_option("--protocol-version", options.protocol_version, "test hook: claim protocol version N in Hello")
       ->type_name("N");
+  app.add_option("--extra-hellos", options.extra_hellos, "test hook: send Hello N more times at once")
+      ->check(CLI::Range(0, 100))
+      ->type_name("N");
   app.add_option("--scene-schema-version", options.scene_schema_version,
                  "test hook: claim scene schema version N in Hello (0: a side built before them)")
       ->type_name("N");

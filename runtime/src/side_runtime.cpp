@@ -113,18 +113,31 @@ class SideRuntime {
     hello->set_host(host_name());
     hello->set_pid(getpid());
     control_->send(hello_envelope);
+    // Repeats never wait: a DEALER with no connected peer (its connection
+    // refused, or its CURVE handshake failed) blocks a send until one comes.
+    std::string hello_bytes;
+    hello_envelope.SerializeToString(&hello_bytes);
+    for (int k = 0; k < options_.extra_hellos; ++k) control_->send_bytes(hello_bytes, false);
     // From now on the coupler hears from this side even during a long setup.
     heartbeat_ = std::make_unique<HeartbeatThread>(*transport_, options_.control_endpoint, options_.role,
                                                    heartbeat_step_, waiting_for_peer_, options_.curve);
 
     const auto deadline = Clock::now() + to_us(options_.welcome_timeout_s);
+    const auto repeat = to_us(options_.hello_repeat_s);
+    auto next_hello = Clock::now() + repeat;
     while (true) {
-      const auto left = std::chrono::duration_cast<microseconds>(deadline - Clock::now());
+      const auto now = Clock::now();
+      const auto left = std::chrono::duration_cast<microseconds>(deadline - now);
       if (left.count() <= 0) {
         throw CouplerLost{"no answer to Hello from the coupler at " + options_.control_endpoint + " within " +
                           std::to_string(options_.welcome_timeout_s) + " s"};
       }
-      auto envelope = control_->receive("the coupler", left);
+      if (now >= next_hello) {  // unanswered: the first may have been lost (SideOptions::hello_repeat_s)
+        control_->send_bytes(hello_bytes, false);
+        next_hello = now + repeat;
+      }
+      const auto until_repeat = std::chrono::duration_cast<microseconds>(next_hello - now);
+      auto envelope = control_->receive("the coupler", std::min(left, std::max(until_repeat, microseconds(1))));
       if (!envelope || envelope->has_heartbeat()) continue;
       if (envelope->has_reject()) {
         std::cerr << role_ << ": the coupler rejected this side: " << envelope->reject().reason() << "\n";

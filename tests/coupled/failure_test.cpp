@@ -94,6 +94,16 @@ TEST(Failure, SideWithAnotherSceneSchemaIsRejected) {
                        0);
 }
 
+// A side repeats its Hello until the coupler answers (a Hello sent on a
+// connection the coupler's ROUTER refused is lost); the coupler takes the
+// first and ignores the others, and the run goes on as if there were one.
+TEST(Failure, RepeatedHellosAreIgnored) {
+  const auto run = run_with("fluid", {"--extra-hellos", "3"});
+  EXPECT_EQ(run.result.exit_code, 0) << run.result.err;
+  EXPECT_NE(read_file(run.out + "/coupler.log").find("fluid side: a repeated Hello ignored"), std::string::npos);
+  EXPECT_EQ(json_string(read_file(run.out + "/run.json"), "status"), "completed");
+}
+
 TEST(Failure, GarbageFromASideIsRejected) {
   const auto run = run_with("fluid", {"--fault", "garbage@30"});
   expect_clean_failure(run, "fluid", "malformed message from the fluid side");

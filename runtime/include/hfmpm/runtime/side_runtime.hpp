@@ -79,11 +79,17 @@ struct SideOptions {
   std::string implementation;    // e.g. "hfmpm-prescribed-solid"
   std::string implementation_version = proto::kProgramVersion;
   std::vector<std::string> capabilities;
-  std::string advertise_host;                                       // tcp: host the peer can reach this side at
-  std::string output_dir;                                           // overrides the coupler's output_dir
-  double welcome_timeout_s = 60;                                    // the coupler must answer Hello within this
-  std::shared_ptr<Transport> transport;                             // shared (in-process sides); ZeroMQ's if null
-  std::uint32_t protocol_version = proto::kProtocolVersion;         // tests claim others
+  std::string advertise_host;     // tcp: host the peer can reach this side at
+  std::string output_dir;         // overrides the coupler's output_dir
+  double welcome_timeout_s = 60;  // the coupler must answer Hello within this
+  // Hello is sent again every hello_repeat_s until the coupler answers: a
+  // ZeroMQ ROUTER refuses a connection whose routing id a peer it has not yet
+  // seen leave still holds, and the Hello sent on it is lost (the coupler
+  // ignores a repeated Hello from a side that has joined).
+  double hello_repeat_s = 1;
+  int extra_hellos = 0;                                      // test hook: send Hello this many more times at once
+  std::shared_ptr<Transport> transport;                      // shared (in-process sides); ZeroMQ's if null
+  std::uint32_t protocol_version = proto::kProtocolVersion;  // tests claim others
   std::uint32_t scene_schema_version = proto::kSceneSchemaVersion;  // tests claim others
   Fault fault;
   // tcp with CURVE (--keys FILE, the sides' key file): the control and
