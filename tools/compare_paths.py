@@ -18,14 +18,12 @@ import math
 import os
 import sys
 
+import layered_sweep
+
 
 def final_path(run):
-    import h5py
-    with h5py.File(os.path.join(run, "solid.h5"), "r") as f:
-        frames = f["frames"]
-        last = frames[sorted(frames.keys())[-1]]
-        pos = last["crack0/positions"][:]
-        return [(float(p[0]), float(p[1])) for p in pos]
+    xs, ys = layered_sweep.final_path(run)  # crack 0 in the last frame of solid.h5
+    return list(zip(xs, ys))
 
 
 def arc(path):

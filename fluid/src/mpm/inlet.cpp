@@ -127,11 +127,15 @@ void FluidSolver::split_inlet() {
     const double b = P.end(0), cut = b - L;
     const double front = grid_.width_integral(cut, b), all = grid_.width_integral(0, b);
     const double m_front = P.mass[0] * (all > 0 ? front / all : L / b);
-    // Each piece takes the particle's affine velocity at its own centre.
-    const double centre = P.s[0], v = P.velocity[0], g = P.gradient[0];
-    P.insert(1, cut + 0.5 * L, L, m_front, v + g * (cut + 0.5 * L - centre));
+    // Each piece takes the particle's affine velocity at its own centre,
+    // measured from the pieces' mass centre (the mass is shared by volume, not
+    // by length), so that the split keeps the momentum exactly.
+    const double v = P.velocity[0], g = P.gradient[0], m = P.mass[0];
+    const double rear = 0.5 * cut, ahead = cut + 0.5 * L;
+    const double centre = ((m - m_front) * rear + m_front * ahead) / m;
+    P.insert(1, ahead, L, m_front, v + g * (ahead - centre));
     P.gradient[1] = g;
-    P.velocity[0] = v + g * (0.5 * cut - centre);
+    P.velocity[0] = v + g * (rear - centre);
     P.s[0] = 0.5 * cut;
     P.length[0] = cut;
     P.mass[0] -= m_front;
