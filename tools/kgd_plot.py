@@ -96,7 +96,10 @@ def scene_parameters(run):
     if not mpm or not fluid or not mpm.get("cracks"):
         sys.exit(f"kgd_plot: {path} is not a KGD scene (an MPM solid with a crack and an MPM fluid); give the flags")
     crack = mpm["cracks"][0]
-    mouth = (float(crack["x_m"][0]), float(crack["y_m"][0]))
+    # Where the fluid enters: the first point (a mouth), or the inlet vertex
+    # of a crack inside the body (two wings; the half-length is half the crack).
+    at = int(crack.get("inlet_vertex", 0))
+    mouth = (float(crack["x_m"][at]), float(crack["y_m"][at]))
     region = None  # the last region that holds the mouth, as the solver assigns material
     for r in mpm.get("regions", []):
         box = r.get("rectangle") or {}
@@ -122,7 +125,22 @@ def scene_parameters(run):
     stress = region.get("initial_stress", {})
     return {"E": float(material["youngs_modulus_pa"]), "nu": float(material["poisson_ratio"]),
             "KIc": float(material.get("toughness_pa_sqrt_m", 0)), "mu": float(fluid["viscosity_pa_s"]),
-            "Q": (2 if symmetric else 1) * q, "sigma0": -float(stress.get("yy_pa", 0)), "t0": t0}
+            "Q": (2 if symmetric else 1) * q, "sigma0": -float(stress.get("yy_pa", 0)), "t0": t0,
+            "two_wing": "inlet_vertex" in crack, "inlet_x": mouth[0]}
+
+
+def wing_lengths(run, inlet_x):
+    """Per solid.h5 frame: (start wing, end wing) lengths along x from the inlet, or [] without h5py."""
+    try:
+        import h5py
+    except ImportError:
+        return []
+    out = []
+    with h5py.File(os.path.join(run, "solid.h5"), "r") as f:
+        for key in sorted(f["frames"].keys()):
+            x = f["frames"][key]["crack0/positions"][:, 0]
+            out.append((inlet_x - x[0], x[-1] - inlet_x))
+    return out
 
 
 def main():
@@ -144,6 +162,12 @@ def main():
             setattr(a, name, from_scene[name])
     print("parameters: " + ", ".join(f"{n} = {getattr(a, n):g}" for n in ("E", "nu", "mu", "Q", "KIc", "sigma0", "t0")))
     h = read_history(os.path.join(a.run, "history.csv"))
+    two_wing = from_scene.get("two_wing", False)
+    if two_wing:
+        # Both wings modelled: the half-length is half the crack (their mean);
+        # how far apart the two are is printed at the end.
+        h["crack_length_m"] = [0.5 * v for v in h["crack_length_m"]]
+        print("two wings from an interior inlet: half-length = crack length / 2")
     t = h["time_s"]
     L0 = h["crack_length_m"][0]
     kmv = km(a.E, a.nu, a.mu, a.Q, a.KIc)
@@ -188,6 +212,12 @@ def main():
     if compare is not None:
         print(f"worst |error| once L >= 3 L0: length {worst[0]:.3f}, opening {worst[1]:.3f}, pressure {worst[2]:.3f}"
               + (f"; fluid front {worst_front:.3f}" if front else ""))
+    if two_wing:
+        wings = wing_lengths(a.run, from_scene["inlet_x"])
+        if wings:
+            apart = max(abs(e - s) / (0.5 * (e + s)) for s, e in wings)
+            print(f"wings: at the end {wings[-1][0]:.4f} m and {wings[-1][1]:.4f} m from the inlet; "
+                  f"largest difference over the frames {apart:.4f} of their mean")
 
     import matplotlib
     matplotlib.use("Agg")

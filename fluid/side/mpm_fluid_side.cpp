@@ -5,9 +5,11 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <stdexcept>
 
 #include "fluid_scene_rules.hpp"
 #include "hfmpm/fluid/mpm/solver.hpp"
+#include "hfmpm/fluid/mpm/two_wing.hpp"
 #include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
@@ -45,12 +47,18 @@ class MpmFluidSide final : public coupling::SideModel {
   void save_checkpoint(const std::string& path, const CheckpointStamp& stamp) override {
     output::write_checkpoint(path, stamp, [&](StateWriter& out) {
       std::vector<std::uint32_t> ids;
+      std::vector<std::uint64_t> two_wing;
       for (const auto& c : cracks_) {
         ids.push_back(c.id);
+        two_wing.push_back(c.wings ? 1 : 0);
         PrefixedWriter solver(out, "fluid" + std::to_string(c.id) + ".");
-        c.solver.save(solver);
+        if (c.wings)
+          c.wings->save(solver);
+        else
+          c.solver.save(solver);
       }
       out.put("side.cracks", ids);
+      out.put("side.two_wing", two_wing);
       out.put("side.received", static_cast<int>(received_));
       out.put("side.substeps", substeps_);
       out.put("side.steps", steps_);
@@ -61,10 +69,19 @@ class MpmFluidSide final : public coupling::SideModel {
     output::read_checkpoint(path, stamp, [&](const StateReader& in) {
       std::vector<std::uint32_t> ids;
       in.get("side.cracks", ids);
-      std::vector<FluidCrack> restored(ids.size(), FluidCrack{0, mpm::FluidSolver(config_)});
+      std::vector<std::uint64_t> two_wing;
+      in.get("side.two_wing", two_wing);
+      if (two_wing.size() != ids.size()) throw std::runtime_error("checkpoint: side.two_wing has the wrong size");
+      std::vector<FluidCrack> restored(ids.size(), FluidCrack{0, mpm::FluidSolver(config_), std::nullopt});
       for (std::size_t i = 0; i < ids.size(); ++i) {
         restored[i].id = ids[i];
-        restored[i].solver.load(PrefixedReader(in, "fluid" + std::to_string(ids[i]) + "."));
+        const PrefixedReader reader(in, "fluid" + std::to_string(ids[i]) + ".");
+        if (two_wing[i] != 0) {
+          restored[i].wings.emplace(config_);
+          restored[i].wings->load(reader);
+        } else {
+          restored[i].solver.load(reader);
+        }
       }
       cracks_ = std::move(restored);
       int received = 0;
@@ -83,7 +100,9 @@ class MpmFluidSide final : public coupling::SideModel {
     // step; the implicit interface step does not (FluidSolver::advance), so
     // its own limit (advection) is the coupled step's.
     const double substeps = config_.implicit_interface ? 1.0 : static_cast<double>(max_substeps_);
-    for (const auto& c : cracks_) dt = std::min(dt, c.solver.stable_dt() * substeps);
+    for (const auto& c : cracks_) {
+      for (const auto* solver : c.solvers()) dt = std::min(dt, solver->stable_dt() * substeps);
+    }
     return dt;
   }
 
@@ -95,30 +114,29 @@ class MpmFluidSide final : public coupling::SideModel {
 
   void advance(double dt) override {
     for (auto& c : cracks_) {
-      substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
-      // An implicit step whose solve failed whole was taken in fluid
-      // substeps (FluidSolver::step_implicit): say so, the first
-      // kReportedRetries times (fluid.log; the count is in the summary).
-      if (config_.implicit_interface && c.solver.interface_last_above_bound() && above_reported_++ < kReportedRetries) {
-        std::fprintf(stderr,
-                     "hfmpm-fluid: crack %u: t = %.9g s: the implicit step of %.6g s was not solved within the bound, "
-                     "whole nor in up to %d fluid substeps; taken whole at its best iterate: %s%s\n",
-                     c.id, c.solver.time(), dt, mpm::FluidSolver::kMaxSubsteps, c.solver.interface_retry_why().c_str(),
-                     above_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
+      if (c.wings) {
+        substeps_ += static_cast<std::uint64_t>(c.wings->advance(dt));
+        if (c.wings->last_iterations() == mpm::TwoWingFluid::kMaxIterations &&
+            junction_reported_++ < kReportedRetries) {
+          std::fprintf(stderr,
+                       "hfmpm-fluid: crack %u: t = %.9g s: the wings' junction did not settle in %d iterations; the "
+                       "inlet pressures differ by %.6g Pa at a share of %.6g into the end wing%s\n",
+                       c.id, c.wings->wing(1).time(), mpm::TwoWingFluid::kMaxIterations,
+                       c.wings->junction_mismatch(), c.wings->share(),
+                       junction_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
+        }
+      } else {
+        substeps_ += static_cast<std::uint64_t>(c.solver.advance(dt));
       }
-      if (config_.implicit_interface && c.solver.interface_substeps() > 1 && retries_reported_++ < kReportedRetries) {
-        std::fprintf(
-            stderr, "hfmpm-fluid: crack %u: t = %.9g s: the implicit step of %.6g s taken in %d fluid substeps: %s%s\n",
-            c.id, c.solver.time(), dt, c.solver.interface_substeps(), c.solver.interface_retry_why().c_str(),
-            retries_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
-      }
+      for (const auto* solver : c.solvers()) report_retries(c.id, *solver, dt);
     }
     ++steps_;
   }
 
   void publish(protocol::DataFrame& frame) override {
     auto* state = frame.mutable_fluid();  // a FluidState even when no crack holds fluid yet
-    for (const auto& c : cracks_) proto::to_proto(c.solver.pressure_message(), state->add_cracks());
+    for (const auto& c : cracks_)
+      proto::to_proto(c.wings ? c.wings->pressure_message() : c.solver.pressure_message(), state->add_cracks());
   }
 
   void receive(const protocol::DataFrame& frame) override {
@@ -136,13 +154,35 @@ class MpmFluidSide final : public coupling::SideModel {
           continue;
         }
         if (!holds_fluid(geometry)) continue;
-        cracks_.push_back(FluidCrack{geometry.crack_id, mpm::FluidSolver(config_)});
+        cracks_.push_back(FluidCrack{geometry.crack_id, mpm::FluidSolver(config_), std::nullopt});
         crack = &cracks_.back();
+        if (geometry.has_inlet) crack->wings.emplace(config_);  // a wellbore inside the body: two wings
       }
-      const bool had_grid = !crack->solver.grid().empty();
+      if (geometry.has_inlet != crack->wings.has_value()) {
+        throw proto::ProtocolError("CrackState: crack " + std::to_string(geometry.crack_id) +
+                                   (geometry.has_inlet ? " has an inlet_id now but had none at step 0"
+                                                       : " had an inlet_id at step 0 but has none now"));
+      }
+      const bool had_grid = !crack->solvers().front()->grid().empty();
       try {
-        if (had_grid) check_crack_update(geometry.crack_id, crack->solver.grid().ids(), geometry.ids, &geometry.grew);
-        crack->solver.set_crack(geometry);
+        if (had_grid) {
+          // A crack whose start is a tip may grow there too (ids prepended).
+          std::size_t prepended = 0;
+          const bool start_tip = !geometry.tip.empty() && geometry.tip.front() != 0;
+          check_crack_update(geometry.crack_id, crack->wings ? crack->wings->ids() : crack->solver.grid().ids(), geometry.ids,
+                             &geometry.grew, start_tip ? &prepended : nullptr);
+        }
+        if (crack->wings && had_grid && geometry.inlet_id != crack->wings->inlet_id()) {
+          throw std::invalid_argument("crack " + std::to_string(geometry.crack_id) + ": inlet_id changed from " +
+                                      std::to_string(crack->wings->inlet_id()) + " to " +
+                                      std::to_string(geometry.inlet_id) +
+                                      "; the fluid enters at one crack particle for the whole run");
+        }
+        if (crack->wings) {
+          crack->wings->set_crack(geometry);
+        } else {
+          crack->solver.set_crack(geometry);
+        }
       } catch (const std::invalid_argument& e) {
         throw proto::ProtocolError(std::string("CrackState: ") + e.what());
       }
@@ -159,6 +199,15 @@ class MpmFluidSide final : public coupling::SideModel {
   }
 
   void finish() override {
+    for (const auto& c : cracks_) {
+      if (!c.wings || steps_ == 0) continue;
+      std::fprintf(stderr,
+                   "hfmpm-fluid: crack %u: two wings from the inlet: %.2f junction iterations per step, %llu steps "
+                   "left above the junction's tolerance after %d; share into the end wing %.6g at the end\n",
+                   c.id, static_cast<double>(c.wings->iterations_total()) / static_cast<double>(steps_),
+                   static_cast<unsigned long long>(c.wings->unconverged_steps()), mpm::TwoWingFluid::kMaxIterations,
+                   c.wings->share());
+    }
     if (!config_.implicit_interface && steps_ > 0) {
       // The fluid's own steps per coupled step (it subcycles at its stable dt).
       std::fprintf(
@@ -167,7 +216,8 @@ class MpmFluidSide final : public coupling::SideModel {
           static_cast<unsigned long long>(steps_));
     }
     for (const auto& c : cracks_) {
-      const auto& s = c.solver;
+     for (const auto* solver : c.solvers()) {
+      const auto& s = *solver;
       if (!config_.implicit_interface || s.steps() == 0) continue;
       std::fprintf(stderr,
                    "hfmpm-fluid: crack %u: %llu implicit steps, %.2f Newton iterations per step, %llu particles "
@@ -182,21 +232,25 @@ class MpmFluidSide final : public coupling::SideModel {
                    static_cast<unsigned long long>(s.interface_subcycled_steps()),
                    static_cast<unsigned long long>(s.interface_max_substeps()),
                    static_cast<unsigned long long>(s.interface_committed_above_bound()));
+     }
     }
   }
 
   SideDiagnostics diagnostics() const override {
     SideDiagnostics d;
     for (std::size_t i = 0; i < cracks_.size(); ++i) {
-      const auto& s = cracks_[i].solver;
-      if (i == 0) d.inlet_pressure = s.inlet_pressure();
-      d.kinetic_energy += s.kinetic_energy();
-      d.injected_volume += s.injected_volume();  // through the mouth (an initial fill is not injected)
-      d.fluid_volume += s.fluid_volume();
-      d.front_position = std::max(d.front_position, s.front_position());
-      d.fluid_particles += static_cast<std::uint32_t>(s.particles().size());
-      d.coupling_lag =
-          std::max(d.coupling_lag, config_.implicit_interface ? s.interface_mismatch() : s.frozen_width_rise());
+      const auto& c = cracks_[i];
+      if (i == 0) d.inlet_pressure = c.wings ? c.wings->inlet_pressure() : c.solver.inlet_pressure();
+      for (const auto* solver : c.solvers()) {
+        const auto& s = *solver;
+        d.kinetic_energy += s.kinetic_energy();
+        d.injected_volume += s.injected_volume();  // through the mouth (an initial fill is not injected)
+        d.fluid_volume += s.fluid_volume();
+        d.front_position = std::max(d.front_position, s.front_position());  // from where the fluid enters
+        d.fluid_particles += static_cast<std::uint32_t>(s.particles().size());
+        d.coupling_lag =
+            std::max(d.coupling_lag, config_.implicit_interface ? s.interface_mismatch() : s.frozen_width_rise());
+      }
     }
     return d;
   }
@@ -206,9 +260,13 @@ class MpmFluidSide final : public coupling::SideModel {
     if (!writer) return;
     writer->begin_frame(t, steps_of_first());
     for (const auto& c : cracks_) {
+      const std::string id = std::to_string(c.id);
+      if (c.wings) {
+        write_two_wing(*writer, id, *c.wings);
+        continue;
+      }
       const auto& s = c.solver;
       const auto& p = s.particles();
-      const std::string id = std::to_string(c.id);
       writer->points("fluid" + id, s.particle_positions());
       writer->scalar("fluid" + id, "arc_length", p.s);
       writer->scalar("fluid" + id, "length", p.length);
@@ -228,8 +286,65 @@ class MpmFluidSide final : public coupling::SideModel {
  private:
   struct FluidCrack {
     std::uint32_t id;
-    mpm::FluidSolver solver;
+    mpm::FluidSolver solver;                 // a crack whose fluid enters at its mouth
+    std::optional<mpm::TwoWingFluid> wings;  // or at an inner particle (a wellbore): then this, not `solver`
+    std::vector<const mpm::FluidSolver*> solvers() const {
+      if (wings) return {&wings->wing(0), &wings->wing(1)};
+      return {&solver};
+    }
   };
+
+  // The retried implicit steps of one solver, the first kReportedRetries times (fluid.log; the count is in the summary).
+  void report_retries(std::uint32_t id, const mpm::FluidSolver& s, double dt) {
+    if (config_.implicit_interface && s.interface_last_above_bound() && above_reported_++ < kReportedRetries) {
+      std::fprintf(stderr,
+                   "hfmpm-fluid: crack %u: t = %.9g s: the implicit step of %.6g s was not solved within the bound, "
+                   "whole nor in up to %d fluid substeps; taken whole at its best iterate: %s%s\n",
+                   id, s.time(), dt, mpm::FluidSolver::kMaxSubsteps, s.interface_retry_why().c_str(),
+                   above_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
+    }
+    if (config_.implicit_interface && s.interface_substeps() > 1 && retries_reported_++ < kReportedRetries) {
+      std::fprintf(stderr,
+                   "hfmpm-fluid: crack %u: t = %.9g s: the implicit step of %.6g s taken in %d fluid substeps: %s%s\n",
+                   id, s.time(), dt, s.interface_substeps(), s.interface_retry_why().c_str(),
+                   retries_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
+    }
+  }
+
+  // Both wings as one fluid on the whole crack: particles of wing 0 then
+  // wing 1, their arc lengths and velocities along the whole crack (from its
+  // first node; wing 0 runs against it); the nodes of the whole crack.
+  static void write_two_wing(output::FrameWriter& writer, const std::string& id, const mpm::TwoWingFluid& wings) {
+    std::vector<Vec2> position;
+    std::vector<double> arc, length, width, pressure, velocity, mass;
+    const double at = wings.arc()[wings.inlet_index()];
+    for (std::size_t w = 0; w < 2; ++w) {
+      const auto& s = wings.wing(w);
+      const auto& p = s.particles();
+      const double sign = w == 0 ? -1.0 : 1.0;
+      const auto xs = s.particle_positions();
+      position.insert(position.end(), xs.begin(), xs.end());
+      for (std::size_t k = 0; k < p.size(); ++k) {
+        arc.push_back(at + sign * p.s[k]);
+        velocity.push_back(sign * p.velocity[k]);
+      }
+      length.insert(length.end(), p.length.begin(), p.length.end());
+      width.insert(width.end(), p.width.begin(), p.width.end());
+      pressure.insert(pressure.end(), p.pressure.begin(), p.pressure.end());
+      mass.insert(mass.end(), p.mass.begin(), p.mass.end());
+    }
+    writer.points("fluid" + id, position);
+    writer.scalar("fluid" + id, "arc_length", arc);
+    writer.scalar("fluid" + id, "length", length);
+    writer.scalar("fluid" + id, "width", width);
+    writer.scalar("fluid" + id, "pressure", pressure);
+    writer.scalar("fluid" + id, "velocity", velocity);
+    writer.scalar("fluid" + id, "mass", mass);
+    writer.points("nodes" + id, wings.positions());
+    writer.scalar("nodes" + id, "arc_length", wings.arc());
+    writer.scalar("nodes" + id, "width", wings.join(wings.wing(0).grid().width(), wings.wing(1).grid().width()));
+    writer.scalar("nodes" + id, "pressure", wings.join(wings.wing(0).nodal_pressure(), wings.wing(1).nodal_pressure()));
+  }
 
   FluidCrack* find(std::uint32_t id) {
     auto it = std::find_if(cracks_.begin(), cracks_.end(), [&](const FluidCrack& c) { return c.id == id; });
@@ -237,16 +352,21 @@ class MpmFluidSide final : public coupling::SideModel {
   }
   bool holds_fluid(const CrackGeometry& g) const {
     if (!listed_.empty()) return listed_.count(g.crack_id) > 0;
-    return !g.tip.empty() && g.tip.front() == 0;  // a mouth
+    return g.has_inlet || (!g.tip.empty() && g.tip.front() == 0);  // a wellbore inside, or a mouth
   }
   void fill(FluidCrack& crack) {
     try {
-      crack.solver.fill(fill_->front_m(), fill_->pressure_pa());
+      if (crack.wings)
+        crack.wings->fill(fill_->front_m(), fill_->pressure_pa());
+      else
+        crack.solver.fill(fill_->front_m(), fill_->pressure_pa());
     } catch (const std::invalid_argument& e) {
       throw coupling::InputError(std::string("fluid.mpm.initial_fill: ") + e.what());
     }
   }
-  std::uint64_t steps_of_first() const { return cracks_.empty() ? 0 : cracks_.front().solver.steps(); }
+  std::uint64_t steps_of_first() const {
+    return cracks_.empty() ? 0 : cracks_.front().solvers().front()->steps();
+  }
 
   mpm::FluidConfig config_;
   std::set<std::uint32_t> listed_;
@@ -256,7 +376,7 @@ class MpmFluidSide final : public coupling::SideModel {
   bool received_ = false;
   std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
   static constexpr int kReportedRetries = 20;
-  int retries_reported_ = 0, above_reported_ = 0;  // subcycled implicit steps written to the log (not checkpointed)
+  int retries_reported_ = 0, above_reported_ = 0, junction_reported_ = 0;  // subcycled implicit steps written to the log (not checkpointed)
   output::SideFrames frames_;                      // the frame file (solid.h5 / fluid.h5) across restarts
 };
 

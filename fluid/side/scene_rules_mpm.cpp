@@ -18,8 +18,8 @@ namespace {
 
 // What the fluid needs to know about each crack of the solid in the scene.
 struct SceneCrack {
-  bool mouth = false;  // the first crack particle is a mouth (not a tip)
-  double length = 0;   // m, initial length along the crack
+  bool mouth = false;  // the fluid can enter: the first point is a mouth, or an inlet vertex is set
+  double length = 0;   // m, initial length along the crack from where the fluid enters (the shorter wing)
 };
 
 std::vector<SceneCrack> scene_cracks(const scene::Solid& solid) {
@@ -28,10 +28,13 @@ std::vector<SceneCrack> scene_cracks(const scene::Solid& solid) {
     out.push_back({true, solid.prescribed_crack().initial_length_m()});
   } else if (solid.has_mpm()) {
     for (const auto& crack : solid.mpm().cracks()) {
-      SceneCrack sc{!crack.start_is_tip(), 0};
+      SceneCrack sc{!crack.start_is_tip() || crack.has_inlet_vertex(), 0};
+      double before = 0;  // the length up to the inlet vertex
       for (int i = 1; i < std::min(crack.x_m_size(), crack.y_m_size()); ++i) {
         sc.length += std::hypot(crack.x_m(i) - crack.x_m(i - 1), crack.y_m(i) - crack.y_m(i - 1));
+        if (crack.has_inlet_vertex() && static_cast<int>(crack.inlet_vertex()) == i) before = sc.length;
       }
+      if (crack.has_inlet_vertex()) sc.length = std::min(before, sc.length - before);
       out.push_back(sc);
     }
   }
@@ -103,7 +106,7 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
     if (filled.empty() && s.solid().model_case() != scene::Solid::MODEL_NOT_SET) {
       c.bad(key + "crack_ids", "(empty)",
             "the ids of the cracks that hold fluid; by default every crack whose first point is a mouth "
-            "(start_is_tip: false), and this scene has none");
+            "(start_is_tip: false) or that has an inlet_vertex, and this scene has none");
     }
   }
   std::set<std::uint32_t> seen;
@@ -123,13 +126,14 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   if (f.has_initial_fill()) {
     const auto& fill = f.initial_fill();
     if (!fill.has_front_m()) {
-      c.missing(key + "initial_fill.front_m", "the arc length (m) the fluid fills from the mouth, > 0");
+      c.missing(key + "initial_fill.front_m",
+                "the arc length (m) the fluid fills from the mouth (each way from an inlet vertex), > 0");
     } else {
       double shortest = kInf;
       for (auto id : filled) shortest = std::min(shortest, cracks[id].length);
       if (std::isfinite(shortest)) {
         c.range(key + "initial_fill.front_m", fill.front_m(), 0, shortest * (1 + 1e-12), true,
-                "m, at most the initial length of every fluid crack");
+                "m, at most the initial length of every fluid crack (of its shorter wing from an inlet vertex)");
       } else {
         c.positive(key + "initial_fill.front_m", fill.front_m(), "m");
       }

@@ -82,6 +82,8 @@ void to_proto(const CrackGeometry& crack, protocol::CrackState::Crack* out) {
   }
   out->set_tip_modulus_pa(crack.tip_modulus);
   out->set_resolution_m(crack.resolution);
+  if (crack.has_inlet) out->set_inlet_id(crack.inlet_id);
+  out->set_start_tip_modulus_pa(crack.start_tip_modulus);
 }
 
 CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
@@ -132,14 +134,29 @@ CrackGeometry from_proto(const protocol::CrackState::Crack& crack) {
     }
   }
   for (const auto& [name, value] : {std::pair<const char*, double>{"tip_modulus_pa", crack.tip_modulus_pa()},
-                                    {"resolution_m", crack.resolution_m()}}) {
+                                    {"resolution_m", crack.resolution_m()},
+                                    {"start_tip_modulus_pa", crack.start_tip_modulus_pa()}}) {
     if (!(value >= 0) || !std::isfinite(value))
       fail(type, id, std::string(name) + " = " + std::to_string(value) + "; it must be finite and >= 0 (0: not sent)");
+  }
+
+  if (crack.has_inlet_id()) {
+    // The fluid enters at an inner particle: one of the ids, neither end.
+    const auto& ids = crack.ids();
+    const auto at = std::find(ids.begin(), ids.end(), crack.inlet_id());
+    if (at == ids.end() || at == ids.begin() || at + 1 == ids.end()) {
+      fail(type, id,
+           "inlet_id = " + std::to_string(crack.inlet_id()) +
+               "; it must be the id of one of the crack's inner particles (neither its first nor its last)");
+    }
   }
 
   CrackGeometry out;
   out.crack_id = id;
   out.grew = crack.grew();
+  out.has_inlet = crack.has_inlet_id();
+  out.inlet_id = crack.inlet_id();
+  out.start_tip_modulus = crack.start_tip_modulus_pa();
   out.tip_modulus = crack.tip_modulus_pa();
   out.resolution = crack.resolution_m();
   out.ids.assign(crack.ids().begin(), crack.ids().end());
@@ -180,6 +197,7 @@ void to_proto(const CrackPressure& crack, protocol::FluidState::Crack* out) {
   out->mutable_stiffness()->Add(crack.stiffness.begin(), crack.stiffness.end());
   out->mutable_width()->Add(crack.width.begin(), crack.width.end());
   out->set_front_position(crack.front_position);
+  out->set_front_start_position(crack.front_start_position);
   out->set_inlet_flux(crack.inlet_flux);
   out->set_fluid_volume(crack.fluid_volume);
 }
@@ -203,9 +221,12 @@ CrackPressure from_proto(const protocol::FluidState::Crack& crack) {
       if (v < 0) fail(type, id, "width must be >= 0");
     }
   }
-  for (double v : {crack.front_position(), crack.inlet_flux(), crack.fluid_volume()}) {
-    if (!std::isfinite(v)) fail(type, id, "front_position, inlet_flux and fluid_volume must be finite");
+  for (double v : {crack.front_position(), crack.front_start_position(), crack.inlet_flux(), crack.fluid_volume()}) {
+    if (!std::isfinite(v))
+      fail(type, id, "front_position, front_start_position, inlet_flux and fluid_volume must be finite");
   }
+  if (crack.front_start_position() < 0)
+    fail(type, id, "front_start_position = " + std::to_string(crack.front_start_position()) + "; it must be >= 0");
   CrackPressure out;
   out.crack_id = id;
   out.ids.assign(crack.ids().begin(), crack.ids().end());
@@ -213,6 +234,7 @@ CrackPressure from_proto(const protocol::FluidState::Crack& crack) {
   out.stiffness.assign(crack.stiffness().begin(), crack.stiffness().end());
   out.width.assign(crack.width().begin(), crack.width().end());
   out.front_position = crack.front_position();
+  out.front_start_position = crack.front_start_position();
   out.inlet_flux = crack.inlet_flux();
   out.fluid_volume = crack.fluid_volume();
   return out;

@@ -98,6 +98,11 @@ class MpmSolidSide final : public coupling::SideModel {
       // For a fluid's tip closure: E' where the crack ends, and the cell.
       g.tip_modulus = solver_->plane_strain_modulus_at(crack.plane().back());
       g.resolution = solver_->config().grid.h;
+      if (crack.has_inlet()) {  // a fluid entering inside the body runs towards both tips
+        g.has_inlet = true;
+        g.inlet_id = crack.inlet_id();
+        g.start_tip_modulus = solver_->plane_strain_modulus_at(crack.plane().front());
+      }
       if (implicit_) {  // the faces' response over the coming step, for the fluid's interface solve
         auto r = solver_->face_response(c);
         g.opening_rate = std::move(r.rate);
@@ -119,13 +124,19 @@ class MpmSolidSide final : public coupling::SideModel {
                                    std::to_string(solver_->cracks().size()) + " crack(s)");
       }
       const auto pressure = proto::from_proto(c);
-      const auto& ids = solver_->cracks()[c.crack_id()].ids();
-      if (!ids_are_prefix(pressure.ids, ids)) {
+      const auto& crack = solver_->cracks()[c.crack_id()];
+      const std::ptrdiff_t offset = ids_run_offset(pressure.ids, crack.ids());
+      if (offset < 0) {
         throw proto::ProtocolError("FluidState crack " + std::to_string(c.crack_id()) +
-                                   ": its ids must be the crack's ids in order (a prefix while the crack grows)");
+                                   ": its ids must be the crack's ids in order (a contiguous run of them while the "
+                                   "crack grows)");
       }
-      solver_->set_crack_pressure(c.crack_id(), pressure.pressure, pressure.stiffness, pressure.width);
-      solver_->set_crack_front(c.crack_id(), pressure.front_position);
+      const auto first = static_cast<std::size_t>(offset);
+      solver_->set_crack_pressure(c.crack_id(), pressure.pressure, pressure.stiffness, pressure.width, first);
+      // The fluid's arc lengths count from the first id it answered for; the
+      // crack may have grown at its start since.
+      const double shift = first > 0 ? arc_length(crack.plane())[first] : 0.0;
+      solver_->set_crack_front(c.crack_id(), pressure.front_start_position + shift, pressure.front_position + shift);
     }
   }
   SideDiagnostics diagnostics() const override {
@@ -136,7 +147,7 @@ class MpmSolidSide final : public coupling::SideModel {
       const auto& crack = solver_->cracks().front();
       const auto s = arc_length(crack.plane());
       d.crack_length = s.back();
-      d.mouth_opening = crack.width(0);
+      d.mouth_opening = crack.width(crack.inlet_index());  // where the fluid enters
       for (std::size_t k = 0; k < crack.size(); ++k)
         d.crack_face_load += crack.face_pressure(k) * crack.tributary_length(k);
     }
@@ -316,6 +327,9 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
       const Vec2 a(cr.x_m(i - 1), cr.y_m(i - 1)), b(cr.x_m(i), cr.y_m(i));
       const int pieces = std::max(1, static_cast<int>(std::ceil((b - a).norm() / spacing - 1e-9)));
       for (int k = 1; k <= pieces; ++k) spec.points.push_back(a + (b - a) * (static_cast<double>(k) / pieces));
+      // The inlet vertex keeps its own crack particle.
+      if (cr.has_inlet_vertex() && static_cast<int>(cr.inlet_vertex()) == i)
+        spec.inlet = static_cast<std::ptrdiff_t>(spec.points.size()) - 1;
     }
     c.cracks.push_back(spec);
   }

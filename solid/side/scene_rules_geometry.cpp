@@ -211,6 +211,21 @@ void check_crack_geometry(Checker& c, const scene::MpmSolid& m) {
         bad = true;
       }
     }
+    // A fluid entering inside the body (a wellbore) enters at an inner vertex
+    // of a crack whose two ends are tips, and flows towards both.
+    if (cr.has_inlet_vertex()) {
+      const auto v = static_cast<std::size_t>(cr.inlet_vertex());
+      if (!cr.start_is_tip() || !cr.end_is_tip()) {
+        c.bad(k + ".inlet_vertex", std::to_string(v),
+              "unset for a crack with a mouth (the fluid enters there); an inlet vertex is for a crack inside the "
+              "body, start_is_tip: true and end_is_tip: true");
+        bad = true;
+      } else if (v < 1 || v + 1 >= pts.size()) {
+        c.bad(k + ".inlet_vertex", std::to_string(v),
+              "an inner vertex of the crack, 1 to " + std::to_string(pts.size() - 2) + " (of x_m / y_m)");
+        bad = true;
+      }
+    }
     if (!bad) usable[static_cast<std::size_t>(i)] = std::move(pts);
   }
   // Two cracks within a cell: a node carries at most two velocity fields

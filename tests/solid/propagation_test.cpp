@@ -94,13 +94,13 @@ TEST(Propagation, TipWaitsForTheFluidFrontWithMaxLag) {
   Solver solid(config);
   const double h = solid.grid().h, dt = solid.stable_dt();
   const std::size_t initial = solid.cracks()[0].size();
-  solid.set_crack_front(0, kDrivenA - 0.6 * h);  // 0.6 cells of dry crack: too far
+  solid.set_crack_front(0, 0.0, kDrivenA - 0.6 * h);  // 0.6 cells of dry crack: too far
   const double transit = 2 * kDrivenH / kRock.p_wave_speed(kRock.density);
   while (solid.time() < 3 * transit) solid.step(dt);
   ASSERT_FALSE(solid.last_tips().empty());
   EXPECT_GT(solid.last_tips().at(0).j, 1.5 * solid.config().materials[0].toughness) << "the load must drive growth";
   EXPECT_EQ(solid.cracks()[0].size(), initial) << "grew with the fluid front 0.6 cells behind the tip";
-  solid.set_crack_front(0, kDrivenA - 0.4 * h);  // within half a cell: may grow
+  solid.set_crack_front(0, 0.0, kDrivenA - 0.4 * h);  // within half a cell: may grow
   for (int k = 0; k < 10 && solid.cracks()[0].size() == initial; ++k) solid.step(dt);
   EXPECT_EQ(solid.cracks()[0].size(), initial + 1);
 }
@@ -130,7 +130,7 @@ TEST(Propagation, StraightQuarterCellGrowthKeepsCrackParticlesHalfACellApart) {
   while (solid.time() < 6 * transit && tips.size() < 9) {
     const auto& line = solid.cracks()[0].plane();
     const double length = (line.back() - line[0]).norm(), segment = (line.back() - line[line.size() - 2]).norm();
-    solid.set_crack_front(0, length - std::min(segment, 0.5 * h));  // the fluid at the tip segment's start
+    solid.set_crack_front(0, 0.0, length - std::min(segment, 0.5 * h));  // the fluid at the tip segment's start
     solid.step(dt);
     const double tip = solid.cracks()[0].plane().back().x();
     if (tip > tips.back() + 0.1 * h) tips.push_back(tip);
@@ -225,11 +225,11 @@ TEST(Propagation, KinkingTipWaitsForTheFieldAfterTheFluidFrontArrives) {
     out.wait = settle * config.fracture.outer_cells * config.grid.h / std::sqrt(kRock.shear_modulus() / kRock.density);
     const double transit = 2 * kH / kRock.p_wave_speed(kRock.density);
     const std::size_t size = solid.cracks()[0].size();
-    solid.set_crack_front(0, 0.1 * kA);
+    solid.set_crack_front(0, 0.0, 0.1 * kA);
     while (solid.time() < 2 * transit) solid.step(out.dt);
     EXPECT_EQ(solid.cracks()[0].size(), size) << "grew with the front far behind the tip";
     out.arrival = solid.time();
-    solid.set_crack_front(0, kA);
+    solid.set_crack_front(0, 0.0, kA);
     while (solid.time() < out.arrival + out.wait + 10 * kCheck * out.dt) {
       solid.step(out.dt);
       if (solid.cracks()[0].size() > size) {
@@ -376,7 +376,7 @@ OpeningProfile edge_crack_opening(double a, bool grow, bool between_rows, bool f
   while (solid.time() < t_end) {
     const double tip = solid.cracks()[0].plane().back().x();
     const bool may_grow = grow && tip < kFinal - 0.1 * h && solid.time() > 5 * transit;
-    solid.set_crack_front(0, may_grow ? tip : 0.0);
+    solid.set_crack_front(0, 0.0, may_grow ? tip : 0.0);
     if (pressurised) solid.set_crack_pressure(0, std::vector<double>(solid.cracks()[0].size(), sigma));
     solid.step(dt);
   }

@@ -74,6 +74,7 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("injected_mass", injected_mass_);
   out.put("outflow_mass", outflow_mass_);
   out.put("inlet_flux", inlet_flux_);
+  out.put("inlet_share", inlet_share_);
   out.put("outlet_wetted", static_cast<int>(outlet_wetted_));
   out.put("wall.rate", wall_rate_);
   out.put("wall.acceleration", wall_acceleration_);
@@ -150,6 +151,7 @@ void FluidSolver::load(const StateReader& in) {
   in.get("injected_mass", injected_mass_);
   in.get("outflow_mass", outflow_mass_);
   in.get("inlet_flux", inlet_flux_);
+  in.get("inlet_share", inlet_share_);
   int wetted = 0;
   in.get("outlet_wetted", wetted);
   outlet_wetted_ = wetted != 0;

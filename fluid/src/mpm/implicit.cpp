@@ -129,7 +129,7 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
   // The inlet particle is re-extended to the mouth with the mass that crossed it (inlet()).
   if (np > 0) {
     if (in.kind == InletConfig::Kind::FlowRate) {
-      t.mass[0] += rho0 * 0.5 * (in.flow_rate(t_) + in.flow_rate(t_ + dt)) * dt;
+      t.mass[0] += inflow_mass(dt);
     } else if (t.a[0] > 0) {
       const double p_in = std::max(0.0, in.pressure(t_ + dt));
       t.mass[0] += rho0 / eos_.volume_ratio(p_in) * integrate(arc, t.width, 0.0, t.a[0]);

@@ -41,12 +41,23 @@ double FluidSolver::inlet_pressure() const {
   return mouth_pressure();
 }
 
+double FluidSolver::inflow_mass(double dt) const {
+  const auto& q = config_.inlet.flow_rate;
+  return inlet_share_ * config_.density * 0.5 * (q(t_) + q(t_ + dt)) * dt;
+}
+
+void FluidSolver::set_inlet_share(double share) {
+  if (!(share >= 0 && share <= 1))
+    throw std::invalid_argument("fluid: the inlet share must be between 0 and 1, got " + std::to_string(share));
+  inlet_share_ = share;
+}
+
 bool FluidSolver::seed(double dt) {
   const auto& inlet = config_.inlet;
   const double rho0 = config_.density;
   const double L = std::min(particle_length_, grid_.length());
   const bool flow_rate = inlet.kind == InletConfig::Kind::FlowRate;
-  const double q = flow_rate ? 0.5 * (inlet.flow_rate(t_) + inlet.flow_rate(t_ + dt)) : 0.0;
+  const double q = flow_rate ? inflow_mass(dt) / (rho0 * dt) : 0.0;
   const double p_in = flow_rate ? 0.0 : std::max(0.0, inlet.pressure(t_ + dt));
   if (!(q > 0) && !(p_in > 0)) return false;  // nothing pushes fluid in yet
   if (grid_.width()[0] <= 0) {
@@ -80,7 +91,7 @@ void FluidSolver::inlet(double dt) {
   const double a = P.start(0), b = P.end(0);
   double dm = 0;
   if (in.kind == InletConfig::Kind::FlowRate) {
-    dm = rho0 * 0.5 * (in.flow_rate(t_) + in.flow_rate(t_ + dt)) * dt;
+    dm = inflow_mass(dt);
   } else if (a > 0) {
     const double p_in = std::max(0.0, in.pressure(t_ + dt));
     dm = rho0 / eos_.volume_ratio(p_in) * grid_.width_integral(0, a);

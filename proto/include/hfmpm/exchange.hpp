@@ -41,6 +41,13 @@ struct CrackGeometry {
   // the length over which the solid resolves the faces' opening (its cell).
   double tip_modulus = 0;  // Pa
   double resolution = 0;   // m
+  // Optional: a fluid entering at an interior crack particle (a wellbore
+  // inside the body) enters at the one with id inlet_id and flows both ways;
+  // start_tip_modulus is E' at the crack's first point, the start tip (0: not
+  // sent). Without has_inlet the fluid enters at the first particle, a mouth.
+  bool has_inlet = false;
+  std::uint64_t inlet_id = 0;
+  double start_tip_modulus = 0;  // Pa
 
   std::size_t size() const { return ids.size(); }
 };
@@ -56,7 +63,11 @@ struct CrackPressure {
   // treats the change over its step implicitly.
   std::vector<double> stiffness;
   std::vector<double> width;
-  double front_position = 0;  // m, arc length from the mouth
+  // m, arc lengths from the first of `ids`: the fluid occupies
+  // [front_start_position, front_position] (front_start_position 0 at a mouth;
+  // > 0 for an interior inlet whose start-side wing has not reached the start).
+  double front_position = 0;
+  double front_start_position = 0;
   double inlet_flux = 0;      // m^2/s
   double fluid_volume = 0;    // m^2
 
@@ -81,40 +92,59 @@ struct SideDiagnostics {
 
 // The protocol's crack-update rule (docs/protocol.md, CrackState), in one
 // place for every side: a crack keeps its particles' ids in order and only
-// appends new ones at its tip; `grew` (when given) says whether it appended
-// since the previous CrackState. Returns the number of ids appended; throws
+// adds new ones at a tip: appended at its end, or, when `prepended` is given
+// (the caller's crack starts at a tip), also prepended at its start, their
+// number stored there. `grew` (when given) says whether ids were added since
+// the previous CrackState. Returns the number of ids appended; throws
 // std::invalid_argument naming the crack and what broke.
 inline std::size_t check_crack_update(std::uint32_t crack_id, const std::vector<std::uint64_t>& before,
-                                      const std::vector<std::uint64_t>& now, const bool* grew = nullptr) {
+                                      const std::vector<std::uint64_t>& now, const bool* grew = nullptr,
+                                      std::size_t* prepended = nullptr) {
   const std::string crack = "crack " + std::to_string(crack_id) + ": ";
   if (now.size() < before.size()) {
     throw std::invalid_argument(crack + "has " + std::to_string(now.size()) + " crack particles, fewer than the " +
                                 std::to_string(before.size()) + " it had: crack particles may not disappear");
   }
+  std::size_t offset = 0;
+  if (prepended && !before.empty()) {
+    while (offset + before.size() < now.size() && now[offset] != before.front()) ++offset;
+  }
   for (std::size_t i = 0; i < before.size(); ++i) {
-    if (now[i] != before[i]) {
-      throw std::invalid_argument(crack + "crack particle " + std::to_string(i) + " has id " + std::to_string(now[i]) +
-                                  " but had id " + std::to_string(before[i]) +
-                                  ": ids may only be appended at the tip, never reordered or removed");
+    if (now[offset + i] != before[i]) {
+      throw std::invalid_argument(crack + "crack particle " + std::to_string(offset + i) + " has id " +
+                                  std::to_string(now[offset + i]) + " but had id " + std::to_string(before[i]) +
+                                  (prepended ? ": ids may only be added at the tips (appended at the end, prepended "
+                                               "at a start tip), never reordered or removed"
+                                             : ": ids may only be appended at the tip, never reordered or removed"));
     }
   }
-  const std::size_t appended = now.size() - before.size();
-  if (grew && *grew != (appended > 0)) {
-    throw std::invalid_argument(crack + "'grew' is " + (*grew ? "true" : "false") + " but " + std::to_string(appended) +
-                                " ids were appended");
+  const std::size_t appended = now.size() - before.size() - offset;
+  if (prepended) *prepended = offset;
+  if (grew && *grew != (appended + offset > 0)) {
+    throw std::invalid_argument(crack + "'grew' is " + (*grew ? "true" : "false") + " but " +
+                                std::to_string(appended + offset) + " ids were added");
   }
   return appended;
 }
 
 // The FluidState rule: the ids a fluid answers with are the crack's ids in
-// order, or a prefix of them while the crack grows (under Jacobi the fluid
-// answers with the ids of the crack it last received).
-inline bool ids_are_prefix(const std::vector<std::uint64_t>& prefix, const std::vector<std::uint64_t>& ids) {
-  if (prefix.size() > ids.size()) return false;
-  for (std::size_t i = 0; i < prefix.size(); ++i) {
-    if (prefix[i] != ids[i]) return false;
+// order, or a contiguous run of them while the crack grows (under Jacobi the
+// fluid answers with the ids of the crack it last received, and a crack may
+// grow at both ends). Returns where the run starts in `ids`, or -1 if `run`
+// is not one.
+inline std::ptrdiff_t ids_run_offset(const std::vector<std::uint64_t>& run, const std::vector<std::uint64_t>& ids) {
+  if (run.size() > ids.size()) return -1;
+  std::size_t offset = 0;
+  if (!run.empty()) {
+    while (offset + run.size() < ids.size() && ids[offset] != run.front()) ++offset;
   }
-  return true;
+  for (std::size_t i = 0; i < run.size(); ++i) {
+    if (run[i] != ids[offset + i]) return -1;
+  }
+  return static_cast<std::ptrdiff_t>(offset);
+}
+inline bool ids_are_prefix(const std::vector<std::uint64_t>& prefix, const std::vector<std::uint64_t>& ids) {
+  return ids_run_offset(prefix, ids) == 0;
 }
 
 // Arc length of each point of a polyline from its first point.

@@ -48,6 +48,7 @@ void Crack::save(StateWriter& out) const {
   out.put("stiffness", stiffness_);
   out.put("reference_width", reference_width_);
   out.put("wetted_length", wetted_length_);
+  out.put("wetted_start", wetted_start_);
   out.put("next_id", next_id_);
   out.put("path", path_);
   out.put("box", std::vector<Vec2>{lo_, hi_});
@@ -68,6 +69,7 @@ void Crack::load(const StateReader& in) {
   in.get("stiffness", stiffness_);
   in.get("reference_width", reference_width_);
   in.get("wetted_length", wetted_length_);
+  in.get("wetted_start", wetted_start_);
   in.get("next_id", next_id_);
   in.get("path", path_);
   std::vector<Vec2> box;
@@ -106,7 +108,9 @@ void Solver::save(StateWriter& out) const {
   std::vector<double> grown;
   for (const auto& g : grown_at_) grown.insert(grown.end(), g.begin(), g.end());
   out.put("grown_at", grown);
-  out.put("front_arrived_at", front_arrived_at_);
+  std::vector<double> arrived;
+  for (const auto& a : front_arrived_at_) arrived.insert(arrived.end(), a.begin(), a.end());
+  out.put("front_arrived_at", arrived);
   out.put("anchored_at", anchored_at_);
   std::vector<Vec2> drift;  // per crack particle, above then below (the crack's size known)
   for (std::size_t c = 0; c < cracks_.size(); ++c) {
@@ -202,7 +206,10 @@ void Solver::load(const StateReader& in) {
   if (grown.size() % 2 != 0) throw std::runtime_error("checkpoint array grown_at has an odd size");
   grown_at_.resize(grown.size() / 2);
   for (std::size_t i = 0; i < grown_at_.size(); ++i) grown_at_[i] = {grown[2 * i], grown[2 * i + 1]};
-  in.get("front_arrived_at", front_arrived_at_);
+  std::vector<double> arrived;
+  in.get("front_arrived_at", arrived);
+  front_arrived_at_.resize(arrived.size() / 2);
+  for (std::size_t i = 0; i < front_arrived_at_.size(); ++i) front_arrived_at_[i] = {arrived[2 * i], arrived[2 * i + 1]};
   in.get("anchored_at", anchored_at_);
   std::vector<double> drift;
   in.get("surface_drift", drift);

@@ -20,6 +20,19 @@ Crack::Crack(std::uint32_t id, const CrackSpec& spec)
     : id_(id), start_is_tip_(spec.start_is_tip), end_is_tip_(spec.end_is_tip) {
   if (spec.points.size() < 2) throw std::invalid_argument("a crack needs at least 2 points");
   for (const auto& p : spec.points) append(p);
+  if (spec.inlet >= 0) {
+    if (!start_is_tip_ || !end_is_tip_ || spec.inlet == 0 || static_cast<std::size_t>(spec.inlet) + 1 >= size()) {
+      throw std::invalid_argument("a crack's inlet must be an inner particle (1 to " + std::to_string(size() - 2) +
+                                  ") of a crack whose two ends are tips; got " + std::to_string(spec.inlet));
+    }
+    has_inlet_ = true;
+    inlet_id_ = ids_[static_cast<std::size_t>(spec.inlet)];
+  }
+}
+
+std::size_t Crack::inlet_index() const {
+  if (!has_inlet_) return 0;
+  return static_cast<std::size_t>(std::find(ids_.begin(), ids_.end(), inlet_id_) - ids_.begin());
 }
 
 void Crack::append(const Vec2& position) { append(position, position); }
@@ -48,11 +61,20 @@ void Crack::prepend(const Vec2& position, const Vec2& reference) {
   to_front(pressure_);
   to_front(stiffness_);
   to_front(reference_width_);
+  shift_wetted((plane_[1] - plane_[0]).norm());  // arc lengths count from the new first particle
+}
+
+void Crack::shift_wetted(double by) {
+  if (wetted_length_ < 0) return;
+  wetted_start_ += by;
+  wetted_length_ += by;
 }
 
 void Crack::move_tip(bool at_end, const Vec2& position, const Vec2& reference) {
   const std::size_t k = at_end ? plane_.size() - 1 : 0;
+  const double before = (plane_[1] - plane_[0]).norm();
   plane_[k] = above_[k] = below_[k] = position;
+  if (!at_end) shift_wetted((plane_[1] - plane_[0]).norm() - before);
   reference_[k] = reference;
 }
 
@@ -73,13 +95,14 @@ double Crack::tributary_length(std::size_t k) const {
 double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(normal(k))); }
 
 void Crack::receive_pressure(const std::vector<double>& pressure, const std::vector<double>& stiffness,
-                             const std::vector<double>& width) {
+                             const std::vector<double>& width, std::size_t offset) {
   const bool stiff = !stiffness.empty() && stiffness.size() == pressure.size() && width.size() == pressure.size();
   for (std::size_t k = 0; k < size(); ++k) {
-    const bool given = k < pressure.size();
-    pressure_[k] = given ? pressure[k] : 0.0;
-    stiffness_[k] = given && stiff ? stiffness[k] : 0.0;
-    reference_width_[k] = given && stiff ? width[k] : 0.0;
+    const bool given = k >= offset && k - offset < pressure.size();
+    const std::size_t i = given ? k - offset : 0;
+    pressure_[k] = given ? pressure[i] : 0.0;
+    stiffness_[k] = given && stiff ? stiffness[i] : 0.0;
+    reference_width_[k] = given && stiff ? width[i] : 0.0;
   }
 }
 

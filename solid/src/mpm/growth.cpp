@@ -40,7 +40,7 @@ int Solver::propagate() {
   int added = 0;
   std::vector<std::array<Vec2, 2>> cut;  // the new segments, old tip to new
   if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
-  if (front_arrived_at_.size() != cracks_.size()) front_arrived_at_.resize(cracks_.size(), -kForever);
+  if (front_arrived_at_.size() != cracks_.size()) front_arrived_at_.resize(cracks_.size(), {-kForever, -kForever});
   // Each crack's length before this check grows any tip: the settling wait of
   // its second tip must not count the growth of its first in the same check
   // (it did, and the two tips of a point-symmetric crack grew at alternate
@@ -55,20 +55,24 @@ int Solver::propagate() {
       const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
       if (t_ - grown_at < config_.fracture.settle_transits * length / c_s) continue;  // still settling
     }
-    if (tip.at_end && config_.fracture.max_lag_cells >= 0 && cracks_[tip.crack].wetted_length() >= 0) {
+    // A start tip waits for the fluid only when the fluid enters inside the
+    // crack (a wellbore, Crack::has_inlet): at a mouth crack the start is no tip.
+    const auto& wet = cracks_[tip.crack];
+    if ((tip.at_end || wet.has_inlet()) && config_.fracture.max_lag_cells >= 0 && wet.wetted_length() >= 0) {
       // The front need not enter the tip segment (its faces close to nothing at
       // the tip): the allowed lag is at least that segment.
-      const auto& plane = cracks_[tip.crack].plane();
+      const auto& plane = wet.plane();
       const std::vector<double> arc = arc_length(plane);
-      const double dry = arc.back() - cracks_[tip.crack].wetted_length();
+      const double dry = tip.at_end ? arc.back() - wet.wetted_length() : wet.wetted_start();
       // At most half a cell of it: straight growth lengthens the tip segment
       // (Crack::move_tip), and an allowance that grew with it let the tip run
       // two growth steps ahead of the fluid within a few steps, which threw
       // the implicit interface solve off (a 1.8 GPa mismatch for a step and a
       // 30 kPa dip of the inlet pressure in a built lab KGD).
-      const double segment = std::min(arc.back() - arc[arc.size() - 2], kMinSegmentCells * h);
+      const double last = tip.at_end ? arc.back() - arc[arc.size() - 2] : arc[1];
+      const double segment = std::min(last, kMinSegmentCells * h);
       const double allowed = std::max(config_.fracture.max_lag_cells * h, segment);
-      double& arrived_at = front_arrived_at_[tip.crack];
+      double& arrived_at = front_arrived_at_[tip.crack][tip.at_end ? 1 : 0];
       if (dry > allowed * (1 + 1e-9)) {  // wait for the fluid (zero-lag closure)
         arrived_at = -kForever;
         continue;
@@ -129,7 +133,7 @@ int Solver::propagate() {
     }
     cut.push_back({tip.position, next});
     grown_at = t_;
-    if (tip.at_end && tip.crack < front_arrived_at_.size()) front_arrived_at_[tip.crack] = -kForever;
+    front_arrived_at_[tip.crack][tip.at_end ? 1 : 0] = -kForever;
     ++added;
   }
   if (!cut.empty() && config_.fracture.reproject_grown) {

@@ -27,11 +27,12 @@ int Solver::field_of(const Vec2& from, const Vec2& node) const {
 }
 
 void Solver::set_crack_pressure(std::size_t c, const std::vector<double>& pressure,
-                                const std::vector<double>& stiffness, const std::vector<double>& width) {
-  cracks_.at(c).receive_pressure(pressure, stiffness, width);
+                                const std::vector<double>& stiffness, const std::vector<double>& width,
+                                std::size_t offset) {
+  cracks_.at(c).receive_pressure(pressure, stiffness, width, offset);
 }
 
-void Solver::set_crack_front(std::size_t c, double arc_length) { cracks_.at(c).set_wetted_length(arc_length); }
+void Solver::set_crack_front(std::size_t c, double start, double end) { cracks_.at(c).set_wetted(start, end); }
 
 // How the face load of one side at crack particle k is shared among the
 // nodes around its surface point: the linear weights w, renormalized over the

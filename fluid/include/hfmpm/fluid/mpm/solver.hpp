@@ -150,6 +150,12 @@ class FluidSolver {
   // stops the run.
   static constexpr int kMaxSubsteps = 256;
 
+  // A flow-rate inlet feeds this crack share x Q(t) (default 1): the part of
+  // a wellbore's flow that one wing of an interior crack takes (two_wing.hpp).
+  // Throws std::invalid_argument unless 0 <= share <= 1.
+  void set_inlet_share(double share);
+  double inlet_share() const { return inlet_share_; }
+
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
   const FluidConfig& config() const { return config_; }
@@ -278,6 +284,9 @@ class FluidSolver {
   std::uint64_t steps_ = 0;
   double injected_mass_ = 0, outflow_mass_ = 0;
   double inlet_flux_ = 0;
+  double inlet_share_ = 1;  // of a flow-rate inlet's Q(t)
+  // kg/m, the zero-pressure mass a flow-rate inlet feeds over [t, t + dt] (share x the trapezoid of Q).
+  double inflow_mass(double dt) const;
   bool outlet_wetted_ = false;
   // implicit interface
   std::vector<double> wall_rate_, wall_acceleration_, wall_compliance_;  // from the solid (CrackGeometry)

@@ -17,6 +17,10 @@ struct CrackSpec {
   std::vector<Vec2> points;   // initial crack particles, in order; at least 2
   bool start_is_tip = false;  // false: the first particle is a mouth on the body's edge
   bool end_is_tip = true;
+  // Index into `points` of the particle where a fluid enters an interior
+  // crack (a wellbore inside the body), or -1: the first particle, a mouth.
+  // An inner particle of a crack whose two ends are tips.
+  std::ptrdiff_t inlet = -1;
 };
 
 class Crack {
@@ -40,14 +44,28 @@ class Crack {
   const std::vector<double>& pressure_stiffness() const { return stiffness_; }
   // Take a new fluid pressure; see Solver::set_crack_pressure.
   void receive_pressure(const std::vector<double>& pressure, const std::vector<double>& stiffness,
-                        const std::vector<double>& width);
+                        const std::vector<double>& width, std::size_t offset = 0);
   // Pa, the pressure on the faces at the current width w:
   // max(0, p - stiffness (w - reference width)).
   double face_pressure(std::size_t k) const;
   // Arc length from the first particle that the fluid has wetted (its front,
-  // m), or negative when no fluid reports one.
+  // m), or negative when no fluid reports one; and where the wetted part
+  // begins (0 at a mouth; the start-side front of a fluid entering at an
+  // interior inlet).
   double wetted_length() const { return wetted_length_; }
-  void set_wetted_length(double s) { wetted_length_ = s; }
+  double wetted_start() const { return wetted_start_; }
+  void set_wetted(double start, double end) {
+    wetted_start_ = start;
+    wetted_length_ = end;
+  }
+  // Moves the wetted part's arc lengths by `by` (m; the start grew), if known.
+  void shift_wetted(double by);
+  // The particle a fluid enters at (CrackSpec::inlet), by id; has_inlet()
+  // false: the first particle.
+  bool has_inlet() const { return has_inlet_; }
+  std::uint64_t inlet_id() const { return inlet_id_; }
+  // Its index now (the crack may have grown at its start), or 0 without one.
+  std::size_t inlet_index() const;
   bool start_is_tip() const { return start_is_tip_; }
   bool end_is_tip() const { return end_is_tip_; }
 
@@ -78,8 +96,8 @@ class Crack {
   // a reference position: the position (a crack of the initial state).
   void append(const Vec2& position);
   void append(const Vec2& position, const Vec2& reference);
-  // Inserts a crack particle before the first (growth of a start tip; only
-  // for cracks inside the body, which no fluid uses); it starts closed.
+  // Inserts a crack particle before the first (growth of a start tip, of a
+  // crack inside the body); it starts closed.
   void prepend(const Vec2& position);
   void prepend(const Vec2& position, const Vec2& reference);
   // Moves the tip particle (the last one, or the first with at_end false) to
@@ -100,7 +118,9 @@ class Crack {
   std::vector<Vec2> plane_, above_, below_, reference_;
   std::vector<double> pressure_;                     // Pa, on the faces, per crack particle
   std::vector<double> stiffness_, reference_width_;  // Pa/m and m, per crack particle
-  double wetted_length_ = -1;
+  double wetted_length_ = -1, wetted_start_ = 0;
+  bool has_inlet_ = false;
+  std::uint64_t inlet_id_ = 0;
   std::uint64_t next_id_ = 0;
   // Side-test geometry: the plane polyline with extended mouth ends.
   std::vector<Vec2> path_;

@@ -133,10 +133,14 @@ class Solver {
   // crack; the rest get 0). Optionally the fluid's stiffness -dp/dw (Pa/m)
   // and the widths (m) the pressure was computed from (both the pressure's
   // size, or empty): the faces then carry p - stiffness (w - width).
+  // `offset`: the crack particle the first value belongs to (a fluid that
+  // has not yet seen the particles a start tip's growth added); particles
+  // without a value carry none.
   void set_crack_pressure(std::size_t c, const std::vector<double>& pressure, const std::vector<double>& stiffness = {},
-                          const std::vector<double>& width = {});
-  // The fluid front on crack c: arc length (m) from its first particle.
-  void set_crack_front(std::size_t c, double arc_length);
+                          const std::vector<double>& width = {}, std::size_t offset = 0);
+  // The fluid on crack c: the arc lengths (m) from its first particle where
+  // the wetted part begins (0 at a mouth) and where its front is.
+  void set_crack_front(std::size_t c, double start, double end);
 
   // J, K_I, K_II and the kink angle at every tip, evaluated now (one pass
   // over the particles near the tips). Quasi-static J: no kinetic terms.
@@ -241,7 +245,7 @@ class Solver {
   std::vector<std::array<double, 2>> grown_at_;  // s, last growth of each crack's (start, end) tip
   // s, when the fluid front came within the end tip's allowed lag (-inf: not
   // since its last growth); Fracture::front_settle_transits.
-  std::vector<double> front_arrived_at_;
+  std::vector<std::array<double, 2>> front_arrived_at_;  // s, per crack (start, end) tip
   double anchored_at_ = -1;  // s, when anchor_crack_surfaces last ran (-1: not yet)
   // Per crack and crack particle, the drift velocity (m/s) of its surface
   // above and below toward the material's opening over the step begun

@@ -1,0 +1,108 @@
+// A fluid that enters a crack at an inner particle (a wellbore inside the
+// body) and flows both ways, towards both tips (docs/fluid.md, "Injection
+// from inside the body").
+//
+// The crack is cut at the inlet particle into two wings, each a 1D MPM fluid
+// (FluidSolver) with its mouth at the inlet: wing 0 runs from the inlet
+// towards the crack's first particle (its start tip), wing 1 towards the
+// last. The two meet at the inlet, where two conditions hold over every step:
+//   1. one pressure: a flow-rate inlet's Q(t) is shared, s Q into wing 1 and
+//      (1 - s) Q into wing 0, with s chosen so that the two wings' inlet
+//      pressures agree (a pressure inlet holds both at p_in(t) already);
+//   2. one body: with the implicit interface (coupling.scheme IMPLICIT) the
+//      faces' response couples the openings near the inlet to the pressures
+//      on both sides of it (the compliance band reaches across); each wing
+//      takes the other's pressures there as a known load.
+// Both are met by iterating the step: the two wings step from the same
+// start, the share is corrected by the secant rule on the pressure
+// difference and the loads across by the pressures just found, until both
+// change by less than kTolerance of the inlet pressure (kMaxIterations at
+// most; a step that ends above is taken and counted). A symmetric crack
+// needs one pass: its share stays 1/2 and its pressures across are those of
+// the step before, which the check confirms.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "hfmpm/exchange.hpp"
+#include "hfmpm/fluid/mpm/solver.hpp"
+#include "hfmpm/state_archive.hpp"
+
+namespace hfmpm::fluid::mpm {
+
+// One wing of a crack whose fluid enters at particle `inlet` (an inner
+// index): particles inlet..last (towards_end) or inlet..0 (reversed, with the
+// normals turned so that "above" stays on the wing's left), the inlet first,
+// as a mouth. The faces' response is cut to the wing; `across` (empty, or
+// one pressure per particle of the whole crack) is the load of the other
+// wing's particles within the compliance band, added to the wing's opening
+// acceleration. E' at the wing's tip is the crack's start_tip_modulus for
+// wing 0.
+CrackGeometry wing_geometry(const CrackGeometry& whole, std::size_t inlet, bool towards_end,
+                            const std::vector<double>& across);
+
+class TwoWingFluid {
+ public:
+  // The steps a junction takes at most, and the agreement it asks, relative
+  // to the larger inlet pressure.
+  static constexpr int kMaxIterations = 8;
+  static constexpr double kTolerance = 1e-4;
+
+  // Throws std::invalid_argument naming a config field out of range (FluidSolver's checks).
+  explicit TwoWingFluid(const FluidConfig& config);
+
+  // The whole crack (has_inlet set, inlet_id one of its inner ids); call
+  // before every step. Throws std::invalid_argument as FluidSolver::set_crack.
+  void set_crack(const CrackGeometry& crack);
+  // Each wing filled from the inlet over min(front, its length) at `pressure`.
+  void fill(double front, double pressure);
+  // One coupled step of dt (s); returns the fluid steps taken (both wings,
+  // every iteration).
+  int advance(double dt);
+
+  // The whole crack's pressures (the inlet's: the mean of the wings'), the
+  // wetted interval [front_start_position, front_position] from its first
+  // particle, the inflow and volume of both wings.
+  CrackPressure pressure_message() const;
+  const FluidSolver& wing(std::size_t w) const { return wings_.at(w); }
+  // A per-node array of each wing (nodes from the inlet) on the whole crack's
+  // nodes, the inlet's value the mean of the two; 0 where a wing has none.
+  std::vector<double> join(const std::vector<double>& wing0, const std::vector<double>& wing1) const;
+  const std::vector<Vec2>& positions() const { return positions_; }  // m, the whole crack's nodes
+  const std::vector<double>& arc() const { return arc_; }              // m, their arc lengths
+  std::size_t inlet_index() const { return inlet_; }
+  const std::vector<std::uint64_t>& ids() const { return whole_.ids; }  // the whole crack's, as last set
+  std::uint64_t inlet_id() const { return whole_.inlet_id; }
+  double share() const { return share_; }  // of a flow-rate inlet's Q, into wing 1
+  double inlet_pressure() const;           // Pa, the mean of the wings'
+  // Pa, the wings' inlet pressures' difference after the last step.
+  double junction_mismatch() const { return mismatch_; }
+  int last_iterations() const { return last_iterations_; }
+  std::uint64_t iterations_total() const { return iterations_total_; }
+  std::uint64_t unconverged_steps() const { return unconverged_; }
+
+  void save(StateWriter& out) const;
+  void load(const StateReader& in);
+
+ private:
+  // The whole crack's pressures from the wings (the inlet's the mean).
+  std::vector<double> merged(const std::array<FluidSolver, 2>& wings) const;
+  void set_wings(std::array<FluidSolver, 2>& wings, const std::vector<double>& across) const;
+
+  std::array<FluidSolver, 2> wings_;
+  std::array<FluidSolver, 2> before_;  // the wings before the last set_crack (each iteration starts there)
+  CrackGeometry whole_;                // the crack as last set
+  std::vector<double> arc_;            // m, its arc lengths
+  std::vector<Vec2> positions_;        // m, its nodes
+  std::vector<double> across_;         // Pa, the whole crack's pressures after the last step
+  std::size_t inlet_ = 0;
+  bool flow_rate_ = false;
+  double share_ = 0.5, slope_ = 0;  // the share, and d(p1 - p0)/d share found last (Pa; 0: none yet)
+  double mismatch_ = 0;
+  int last_iterations_ = 0;
+  std::uint64_t iterations_total_ = 0, unconverged_ = 0;
+};
+
+}  // namespace hfmpm::fluid::mpm

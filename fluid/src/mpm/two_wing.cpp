@@ -1,0 +1,238 @@
+// A fluid entering a crack at an inner particle: two wings and their
+// junction (two_wing.hpp; docs/fluid.md, "Injection from inside the body").
+#include "hfmpm/fluid/mpm/two_wing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hfmpm::fluid::mpm {
+namespace {
+
+std::size_t inlet_of(const CrackGeometry& crack) {
+  const std::string name = "fluid: crack " + std::to_string(crack.crack_id) + ": ";
+  if (!crack.has_inlet) throw std::invalid_argument(name + "a two-wing fluid needs the crack's inlet_id");
+  const auto at = std::find(crack.ids.begin(), crack.ids.end(), crack.inlet_id);
+  if (at == crack.ids.end() || at == crack.ids.begin() || at + 1 == crack.ids.end()) {
+    throw std::invalid_argument(name + "inlet_id " + std::to_string(crack.inlet_id) +
+                                " is not one of the crack's inner particles");
+  }
+  return static_cast<std::size_t>(at - crack.ids.begin());
+}
+
+}  // namespace
+
+CrackGeometry wing_geometry(const CrackGeometry& whole, std::size_t inlet, bool towards_end,
+                            const std::vector<double>& across) {
+  const std::size_t n = whole.size();
+  if (inlet == 0 || inlet + 1 >= n) throw std::invalid_argument("fluid: a wing's inlet must be an inner particle");
+  const std::size_t m = towards_end ? n - inlet : inlet + 1;
+  auto global = [&](std::size_t i) { return towards_end ? inlet + i : inlet - i; };
+  CrackGeometry g;
+  g.crack_id = whole.crack_id;
+  g.tip_modulus = towards_end ? whole.tip_modulus : whole.start_tip_modulus;
+  g.resolution = whole.resolution;
+  const double turn = towards_end ? 1.0 : -1.0;  // "above" is the left of the wing's own direction
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t k = global(i);
+    g.ids.push_back(whole.ids[k]);
+    g.position.push_back(whole.position[k]);
+    g.normal.push_back(turn * whole.normal[k]);
+    g.width.push_back(whole.width[k]);
+    g.tip.push_back(i == 0 ? 0 : whole.tip[k]);
+  }
+  if (whole.opening_rate.empty()) return g;
+  const std::size_t B = whole.compliance_band, row = 2 * B + 1;
+  const std::size_t Bw = std::min<std::size_t>(B, m - 1), wrow = 2 * Bw + 1;
+  auto C = [&](std::size_t k, std::size_t j) { return whole.opening_compliance[k * row + j + B - k]; };
+  auto other = [&](std::size_t j) { return towards_end ? j < inlet : j > inlet; };
+  g.compliance_band = static_cast<std::uint32_t>(Bw);
+  g.opening_compliance.assign(m * wrow, 0.0);
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t k = global(i);
+    g.opening_rate.push_back(whole.opening_rate[k]);
+    double acceleration = whole.opening_acceleration[k];
+    const std::size_t lo = k >= B ? k - B : 0, hi = std::min(n - 1, k + B);
+    for (std::size_t j = lo; j <= hi; ++j) {
+      if (other(j)) {
+        if (!across.empty()) acceleration += C(k, j) * across[j];
+        continue;
+      }
+      const std::size_t l = towards_end ? j - inlet : inlet - j;  // the wing's own column
+      if (l + Bw >= i && l <= i + Bw) g.opening_compliance[i * wrow + l + Bw - i] = C(k, j);
+    }
+    g.opening_acceleration.push_back(acceleration);
+    if (!whole.plane_rate.empty()) {
+      g.plane_rate.push_back(whole.plane_rate[k]);
+      g.plane_acceleration.push_back(whole.plane_acceleration[k]);
+    }
+  }
+  return g;
+}
+
+TwoWingFluid::TwoWingFluid(const FluidConfig& config)
+    : wings_{FluidSolver(config), FluidSolver(config)},
+      before_{wings_},
+      flow_rate_(config.inlet.kind == InletConfig::Kind::FlowRate) {}
+
+std::vector<double> TwoWingFluid::join(const std::vector<double>& wing0, const std::vector<double>& wing1) const {
+  std::vector<double> out(whole_.size(), 0.0);
+  for (std::size_t i = 0; i < wing1.size() && inlet_ + i < out.size(); ++i) out[inlet_ + i] = wing1[i];
+  for (std::size_t i = 0; i < wing0.size() && i <= inlet_; ++i) out[inlet_ - i] = wing0[i];
+  if (!wing0.empty() && !wing1.empty() && inlet_ < out.size()) out[inlet_] = 0.5 * (wing0[0] + wing1[0]);
+  return out;
+}
+
+std::vector<double> TwoWingFluid::merged(const std::array<FluidSolver, 2>& wings) const {
+  return join(wings[0].nodal_pressure(), wings[1].nodal_pressure());
+}
+
+void TwoWingFluid::set_wings(std::array<FluidSolver, 2>& wings, const std::vector<double>& across) const {
+  for (std::size_t w = 0; w < 2; ++w) wings[w].set_crack(wing_geometry(whole_, inlet_, w == 1, across));
+}
+
+void TwoWingFluid::set_crack(const CrackGeometry& crack) {
+  const std::size_t inlet = inlet_of(crack);
+  whole_ = crack;
+  inlet_ = inlet;
+  arc_ = arc_length(crack.position);
+  positions_ = crack.position;
+  // The pressures across the inlet after the last step, on the new crack
+  // (the wings count from the inlet, so growth at either end keeps them in place).
+  const std::vector<double> across = wings_[0].grid().empty() ? std::vector<double>{} : merged(wings_);
+  before_ = wings_;
+  set_wings(wings_, across);
+}
+
+void TwoWingFluid::fill(double front, double pressure) {
+  if (wings_[0].grid().empty()) throw std::logic_error("fluid: set_crack() must be called before fill()");
+  for (auto& w : wings_) w.fill(std::min(front, w.grid().length()), pressure);
+  // A later iteration of the first step starts from here (set to the crack
+  // already; setting it again to the same crack moves nothing).
+  before_ = wings_;
+}
+
+int TwoWingFluid::advance(double dt) {
+  const bool implicit = wings_[0].config().implicit_interface && !whole_.opening_rate.empty();
+  int steps = 0;
+  std::array<FluidSolver, 2> trial = wings_;  // set with the loads across from the step before
+  std::vector<double> across = merged(before_);
+  double s = share_, s_prev = 0, r_prev = 0;
+  bool have_prev = false;
+  for (int it = 1;; ++it) {
+    if (it > 1) {
+      trial = before_;
+      set_wings(trial, across);
+    }
+    trial[0].set_inlet_share(flow_rate_ ? 1 - s : 1);
+    trial[1].set_inlet_share(flow_rate_ ? s : 1);
+    for (auto& w : trial) steps += w.advance(dt);
+    const double p0 = trial[0].inlet_pressure(), p1 = trial[1].inlet_pressure(), r = p1 - p0;
+    const std::vector<double> found = merged(trial);
+    double change = 0, largest = std::max(p0, p1);
+    for (double p : found) largest = std::max(largest, p);
+    if (implicit) {
+      const std::size_t B = whole_.compliance_band;
+      const std::size_t lo = inlet_ >= B ? inlet_ - B : 0, hi = std::min(found.size() - 1, inlet_ + B);
+      for (std::size_t j = lo; j <= hi; ++j) {
+        if (j != inlet_ && j < across.size()) change = std::max(change, std::abs(found[j] - across[j]));
+      }
+    }
+    const double tolerance = kTolerance * largest;
+    const bool agree = !flow_rate_ || std::abs(r) <= tolerance;
+    const bool converged = agree && change <= tolerance;
+    if (converged || it == kMaxIterations) {
+      wings_ = std::move(trial);
+      share_ = s;
+      mismatch_ = r;
+      last_iterations_ = it;
+      iterations_total_ += static_cast<std::uint64_t>(it);
+      if (!converged) ++unconverged_;
+      return steps;
+    }
+    if (!agree) {
+      // The secant rule on r(s) = p1 - p0, which rises with s (more flow into
+      // wing 1 raises its pressure and lowers wing 0's).
+      if (have_prev && s != s_prev) {
+        const double slope = (r - r_prev) / (s - s_prev);
+        if (slope > 0) slope_ = slope;
+      }
+      r_prev = r;
+      s_prev = s;
+      have_prev = true;
+      const double next = slope_ > 0 ? s - r / slope_ : s - (r > 0 ? 0.01 : -0.01);
+      s = std::clamp(next, 0.0, 1.0);
+    }
+    across = found;
+  }
+}
+
+double TwoWingFluid::inlet_pressure() const { return 0.5 * (wings_[0].inlet_pressure() + wings_[1].inlet_pressure()); }
+
+CrackPressure TwoWingFluid::pressure_message() const {
+  CrackPressure m;
+  m.crack_id = whole_.crack_id;
+  m.ids = whole_.ids;
+  m.pressure = merged(wings_);
+  if (!wings_[0].config().implicit_interface) {
+    // -dp/dw from each wing (the inlet's the mean), at the widths they used.
+    m.stiffness = join(wings_[0].nodal_stiffness(), wings_[1].nodal_stiffness());
+    m.width = whole_.width;
+  }
+  const double at = arc_.empty() ? 0.0 : arc_[inlet_];
+  m.front_position = at + wings_[1].front_position();
+  m.front_start_position = std::max(0.0, at - wings_[0].front_position());
+  m.inlet_flux = wings_[0].inlet_flux() + wings_[1].inlet_flux();
+  m.fluid_volume = wings_[0].fluid_volume() + wings_[1].fluid_volume();
+  return m;
+}
+
+void TwoWingFluid::save(StateWriter& out) const {
+  for (std::size_t w = 0; w < 2; ++w) {
+    PrefixedWriter wing(out, "wing" + std::to_string(w) + ".");
+    wings_[w].save(wing);
+  }
+  out.put("whole.crack_id", whole_.crack_id);
+  out.put("whole.ids", whole_.ids);
+  out.put("whole.inlet_id", whole_.inlet_id);
+  out.put("whole.width", whole_.width);
+  out.put("whole.arc", arc_);
+  out.put("whole.position", positions_);
+  out.put("inlet", static_cast<std::uint64_t>(inlet_));
+  out.put("share", share_);
+  out.put("slope", slope_);
+  out.put("mismatch", mismatch_);
+  out.put("last_iterations", last_iterations_);
+  out.put("iterations_total", iterations_total_);
+  out.put("unconverged", unconverged_);
+}
+
+void TwoWingFluid::load(const StateReader& in) {
+  for (std::size_t w = 0; w < 2; ++w) wings_[w].load(PrefixedReader(in, "wing" + std::to_string(w) + "."));
+  before_ = wings_;
+  in.get("whole.crack_id", whole_.crack_id);
+  in.get("whole.ids", whole_.ids);
+  in.get("whole.inlet_id", whole_.inlet_id);
+  whole_.has_inlet = true;
+  in.get("whole.width", whole_.width);
+  in.get("whole.arc", arc_);
+  in.get("whole.position", positions_);
+  std::uint64_t inlet = 0;
+  in.get("inlet", inlet);
+  inlet_ = static_cast<std::size_t>(inlet);
+  whole_.position = positions_;
+  if (whole_.width.size() != whole_.ids.size() || arc_.size() != whole_.ids.size() ||
+      positions_.size() != whole_.ids.size() || inlet_ + 1 >= arc_.size() ||
+      inlet_ == 0) {
+    throw std::runtime_error("checkpoint: the two-wing fluid's crack arrays differ in size or its inlet is not inner");
+  }
+  in.get("share", share_);
+  in.get("slope", slope_);
+  in.get("mismatch", mismatch_);
+  in.get("last_iterations", last_iterations_);
+  in.get("iterations_total", iterations_total_);
+  in.get("unconverged", unconverged_);
+}
+
+}  // namespace hfmpm::fluid::mpm
