@@ -120,9 +120,9 @@ class MpmFluidSide final : public coupling::SideModel {
             junction_reported_++ < kReportedRetries) {
           std::fprintf(stderr,
                        "hfmpm-fluid: crack %u: t = %.9g s: the wings' junction did not settle in %d iterations; the "
-                       "inlet pressures differ by %.6g Pa at a share of %.6g into the end wing%s\n",
+                       "inlet pressures differ by %.6g Pa with %.6g m^2/s passed to the end wing%s\n",
                        c.id, c.wings->wing(1).time(), mpm::TwoWingFluid::kMaxIterations,
-                       c.wings->junction_mismatch(), c.wings->share(),
+                       c.wings->junction_mismatch(), c.wings->transfer(),
                        junction_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
         }
       } else {

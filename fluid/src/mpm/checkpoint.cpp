@@ -75,6 +75,7 @@ void FluidSolver::save(StateWriter& out) const {
   out.put("outflow_mass", outflow_mass_);
   out.put("inlet_flux", inlet_flux_);
   out.put("inlet_share", inlet_share_);
+  out.put("inlet_transfer", inlet_transfer_);
   out.put("outlet_wetted", static_cast<int>(outlet_wetted_));
   out.put("wall.rate", wall_rate_);
   out.put("wall.acceleration", wall_acceleration_);
@@ -152,6 +153,7 @@ void FluidSolver::load(const StateReader& in) {
   in.get("outflow_mass", outflow_mass_);
   in.get("inlet_flux", inlet_flux_);
   in.get("inlet_share", inlet_share_);
+  in.get("inlet_transfer", inlet_transfer_);
   int wetted = 0;
   in.get("outlet_wetted", wetted);
   outlet_wetted_ = wetted != 0;

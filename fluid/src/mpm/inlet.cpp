@@ -43,13 +43,16 @@ double FluidSolver::inlet_pressure() const {
 
 double FluidSolver::inflow_mass(double dt) const {
   const auto& q = config_.inlet.flow_rate;
-  return inlet_share_ * config_.density * 0.5 * (q(t_) + q(t_ + dt)) * dt;
+  return config_.density * (inlet_share_ * 0.5 * (q(t_) + q(t_ + dt)) + inlet_transfer_) * dt;
 }
 
-void FluidSolver::set_inlet_share(double share) {
+void FluidSolver::set_inlet_split(double share, double transfer) {
   if (!(share >= 0 && share <= 1))
     throw std::invalid_argument("fluid: the inlet share must be between 0 and 1, got " + std::to_string(share));
+  if (!std::isfinite(transfer))
+    throw std::invalid_argument("fluid: the inlet transfer must be finite, got " + std::to_string(transfer));
   inlet_share_ = share;
+  inlet_transfer_ = transfer;
 }
 
 bool FluidSolver::seed(double dt) {

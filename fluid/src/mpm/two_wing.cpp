@@ -74,7 +74,14 @@ CrackGeometry wing_geometry(const CrackGeometry& whole, std::size_t inlet, bool 
 TwoWingFluid::TwoWingFluid(const FluidConfig& config)
     : wings_{FluidSolver(config), FluidSolver(config)},
       before_{wings_},
-      flow_rate_(config.inlet.kind == InletConfig::Kind::FlowRate) {}
+      flow_rate_(config.inlet.kind == InletConfig::Kind::FlowRate) {
+  if (!config.implicit_interface) {
+    throw std::invalid_argument(
+        "fluid: a fluid entering at an inner crack particle needs the implicit interface step (implicit_interface; "
+        "coupling.scheme IMPLICIT): under the explicit step one transfer between the wings per coupled step does "
+        "not hold them to one pressure");
+  }
+}
 
 std::vector<double> TwoWingFluid::join(const std::vector<double>& wing0, const std::vector<double>& wing1) const {
   std::vector<double> out(whole_.size(), 0.0);
@@ -118,15 +125,15 @@ int TwoWingFluid::advance(double dt) {
   int steps = 0;
   std::array<FluidSolver, 2> trial = wings_;  // set with the loads across from the step before
   std::vector<double> across = merged(before_);
-  double s = share_, s_prev = 0, r_prev = 0;
+  double x = transfer_, x_prev = 0, r_prev = 0;
   bool have_prev = false;
   for (int it = 1;; ++it) {
     if (it > 1) {
       trial = before_;
       set_wings(trial, across);
     }
-    trial[0].set_inlet_share(flow_rate_ ? 1 - s : 1);
-    trial[1].set_inlet_share(flow_rate_ ? s : 1);
+    trial[0].set_inlet_split(flow_rate_ ? 0.5 : 1, flow_rate_ ? -x : 0);
+    trial[1].set_inlet_split(flow_rate_ ? 0.5 : 1, flow_rate_ ? x : 0);
     for (auto& w : trial) steps += w.advance(dt);
     const double p0 = trial[0].inlet_pressure(), p1 = trial[1].inlet_pressure(), r = p1 - p0;
     const std::vector<double> found = merged(trial);
@@ -144,7 +151,7 @@ int TwoWingFluid::advance(double dt) {
     const bool converged = agree && change <= tolerance;
     if (converged || it == kMaxIterations) {
       wings_ = std::move(trial);
-      share_ = s;
+      transfer_ = x;
       mismatch_ = r;
       last_iterations_ = it;
       iterations_total_ += static_cast<std::uint64_t>(it);
@@ -152,20 +159,26 @@ int TwoWingFluid::advance(double dt) {
       return steps;
     }
     if (!agree) {
-      // The secant rule on r(s) = p1 - p0, which rises with s (more flow into
-      // wing 1 raises its pressure and lowers wing 0's).
-      if (have_prev && s != s_prev) {
-        const double slope = (r - r_prev) / (s - s_prev);
+      // The secant rule on r(x) = p1 - p0, which rises with x (more flow into
+      // wing 1 raises its pressure and lowers wing 0's); its slope is kept
+      // from step to step. Without one yet, a probe of 1% of the flow.
+      if (have_prev && x != x_prev) {
+        const double slope = (r - r_prev) / (x - x_prev);
         if (slope > 0) slope_ = slope;
       }
       r_prev = r;
-      s_prev = s;
+      x_prev = x;
       have_prev = true;
-      const double next = slope_ > 0 ? s - r / slope_ : s - (r > 0 ? 0.01 : -0.01);
-      s = std::clamp(next, 0.0, 1.0);
+      const double q = std::abs(wings_[0].config().inlet.flow_rate(wings_[0].time() + dt));
+      x = slope_ > 0 ? x - r / slope_ : x - (r > 0 ? 1 : -1) * 1e-2 * std::max({q, std::abs(x), 1e-12});
     }
     across = found;
   }
+}
+
+double TwoWingFluid::share() const {
+  const double q0 = wings_[0].inlet_flux(), q1 = wings_[1].inlet_flux();
+  return q0 + q1 != 0 ? q1 / (q0 + q1) : 0.5;
 }
 
 double TwoWingFluid::inlet_pressure() const { return 0.5 * (wings_[0].inlet_pressure() + wings_[1].inlet_pressure()); }
@@ -200,7 +213,7 @@ void TwoWingFluid::save(StateWriter& out) const {
   out.put("whole.arc", arc_);
   out.put("whole.position", positions_);
   out.put("inlet", static_cast<std::uint64_t>(inlet_));
-  out.put("share", share_);
+  out.put("transfer", transfer_);
   out.put("slope", slope_);
   out.put("mismatch", mismatch_);
   out.put("last_iterations", last_iterations_);
@@ -227,7 +240,7 @@ void TwoWingFluid::load(const StateReader& in) {
       inlet_ == 0) {
     throw std::runtime_error("checkpoint: the two-wing fluid's crack arrays differ in size or its inlet is not inner");
   }
-  in.get("share", share_);
+  in.get("transfer", transfer_);
   in.get("slope", slope_);
   in.get("mismatch", mismatch_);
   in.get("last_iterations", last_iterations_);

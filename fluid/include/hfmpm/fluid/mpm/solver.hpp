@@ -150,11 +150,14 @@ class FluidSolver {
   // stops the run.
   static constexpr int kMaxSubsteps = 256;
 
-  // A flow-rate inlet feeds this crack share x Q(t) (default 1): the part of
-  // a wellbore's flow that one wing of an interior crack takes (two_wing.hpp).
-  // Throws std::invalid_argument unless 0 <= share <= 1.
-  void set_inlet_share(double share);
+  // A flow-rate inlet feeds this crack share x Q(t) + transfer (m^2/s; by
+  // default 1 x Q(t) + 0): one wing of a crack entered at an inner particle
+  // takes half of a wellbore's Q(t) and the flow the junction passes to it
+  // from the other wing (two_wing.hpp; may be negative). Throws
+  // std::invalid_argument unless 0 <= share <= 1 and transfer is finite.
+  void set_inlet_split(double share, double transfer);
   double inlet_share() const { return inlet_share_; }
+  double inlet_transfer() const { return inlet_transfer_; }
 
   double time() const { return t_; }
   std::uint64_t steps() const { return steps_; }
@@ -284,8 +287,8 @@ class FluidSolver {
   std::uint64_t steps_ = 0;
   double injected_mass_ = 0, outflow_mass_ = 0;
   double inlet_flux_ = 0;
-  double inlet_share_ = 1;  // of a flow-rate inlet's Q(t)
-  // kg/m, the zero-pressure mass a flow-rate inlet feeds over [t, t + dt] (share x the trapezoid of Q).
+  double inlet_share_ = 1, inlet_transfer_ = 0;  // of a flow-rate inlet's Q(t), and m^2/s besides
+  // kg/m, the zero-pressure mass a flow-rate inlet feeds over [t, t + dt] (share x the trapezoid of Q + transfer).
   double inflow_mass(double dt) const;
   bool outlet_wetted_ = false;
   // implicit interface

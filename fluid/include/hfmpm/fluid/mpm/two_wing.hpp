@@ -6,20 +6,22 @@
 // (FluidSolver) with its mouth at the inlet: wing 0 runs from the inlet
 // towards the crack's first particle (its start tip), wing 1 towards the
 // last. The two meet at the inlet, where two conditions hold over every step:
-//   1. one pressure: a flow-rate inlet's Q(t) is shared, s Q into wing 1 and
-//      (1 - s) Q into wing 0, with s chosen so that the two wings' inlet
-//      pressures agree (a pressure inlet holds both at p_in(t) already);
+//   1. one pressure: a flow-rate inlet's Q(t) is split, Q / 2 + x into wing 1
+//      and Q / 2 - x into wing 0, with the junction's transfer x (m^2/s, of
+//      either sign: fluid may also flow from one wing into the other) chosen
+//      so that the two wings' inlet pressures agree at the end of the step
+//      (a pressure inlet holds both at p_in(t) already);
 //   2. one body: with the implicit interface (coupling.scheme IMPLICIT) the
 //      faces' response couples the openings near the inlet to the pressures
 //      on both sides of it (the compliance band reaches across); each wing
 //      takes the other's pressures there as a known load.
 // Both are met by iterating the step: the two wings step from the same
-// start, the share is corrected by the secant rule on the pressure
-// difference and the loads across by the pressures just found, until both
-// change by less than kTolerance of the inlet pressure (kMaxIterations at
-// most; a step that ends above is taken and counted). A symmetric crack
-// needs one pass: its share stays 1/2 and its pressures across are those of
-// the step before, which the check confirms.
+// start, the transfer is corrected by the secant rule on the pressure
+// difference and the loads across by the pressures just found, until the
+// difference and the change of those loads are below kTolerance of the
+// largest pressure in the crack (kMaxIterations at most; a step that ends
+// above is taken and counted). A symmetric crack needs one pass when its
+// pressures across the inlet change little over a step: its transfer stays 0.
 #pragma once
 
 #include <array>
@@ -75,7 +77,10 @@ class TwoWingFluid {
   std::size_t inlet_index() const { return inlet_; }
   const std::vector<std::uint64_t>& ids() const { return whole_.ids; }  // the whole crack's, as last set
   std::uint64_t inlet_id() const { return whole_.inlet_id; }
-  double share() const { return share_; }  // of a flow-rate inlet's Q, into wing 1
+  // m^2/s, the junction's transfer into wing 1 over the last step (a flow-rate
+  // inlet's); and the share of the inflow that wing 1 took (1/2 without inflow).
+  double transfer() const { return transfer_; }
+  double share() const;
   double inlet_pressure() const;           // Pa, the mean of the wings'
   // Pa, the wings' inlet pressures' difference after the last step.
   double junction_mismatch() const { return mismatch_; }
@@ -99,7 +104,7 @@ class TwoWingFluid {
   std::vector<double> across_;         // Pa, the whole crack's pressures after the last step
   std::size_t inlet_ = 0;
   bool flow_rate_ = false;
-  double share_ = 0.5, slope_ = 0;  // the share, and d(p1 - p0)/d share found last (Pa; 0: none yet)
+  double transfer_ = 0, slope_ = 0;  // m^2/s, and d(p1 - p0)/d transfer found last (Pa s/m^2; 0: none yet)
   double mismatch_ = 0;
   int last_iterations_ = 0;
   std::uint64_t iterations_total_ = 0, unconverged_ = 0;
