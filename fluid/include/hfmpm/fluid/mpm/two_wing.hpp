@@ -22,6 +22,11 @@
 // largest pressure in the crack (kMaxIterations at most; a step that ends
 // above is taken and counted). A symmetric crack needs one pass when its
 // pressures across the inlet change little over a step: its transfer stays 0.
+// Only with the implicit interface step (FluidConfig::implicit_interface):
+// the explicit fluid's pressure waves cross many of its substeps within a
+// coupled step, and one transfer per coupled step, set so that the pressures
+// agree at its end, let them drift apart from step to step (measured: the
+// first iteration's mismatch doubled every few steps in a rigid channel).
 #pragma once
 
 #include <array>
@@ -52,7 +57,8 @@ class TwoWingFluid {
   static constexpr int kMaxIterations = 8;
   static constexpr double kTolerance = 1e-4;
 
-  // Throws std::invalid_argument naming a config field out of range (FluidSolver's checks).
+  // Throws std::invalid_argument naming a config field out of range (FluidSolver's checks), or
+  // without config.implicit_interface.
   explicit TwoWingFluid(const FluidConfig& config);
 
   // The whole crack (has_inlet set, inlet_id one of its inner ids); call
