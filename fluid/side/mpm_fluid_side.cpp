@@ -121,8 +121,8 @@ class MpmFluidSide final : public coupling::SideModel {
           std::fprintf(stderr,
                        "hfmpm-fluid: crack %u: t = %.9g s: the wings' junction did not settle in %d iterations; the "
                        "inlet pressures differ by %.6g Pa with %.6g m^2/s passed to the end wing%s\n",
-                       c.id, c.wings->wing(1).time(), mpm::TwoWingFluid::kMaxIterations,
-                       c.wings->junction_mismatch(), c.wings->transfer(),
+                       c.id, c.wings->wing(1).time(), mpm::TwoWingFluid::kMaxIterations, c.wings->junction_mismatch(),
+                       c.wings->transfer(),
                        junction_reported_ == kReportedRetries ? " (further ones are only counted)" : "");
         }
       } else {
@@ -169,8 +169,8 @@ class MpmFluidSide final : public coupling::SideModel {
           // A crack whose start is a tip may grow there too (ids prepended).
           std::size_t prepended = 0;
           const bool start_tip = !geometry.tip.empty() && geometry.tip.front() != 0;
-          check_crack_update(geometry.crack_id, crack->wings ? crack->wings->ids() : crack->solver.grid().ids(), geometry.ids,
-                             &geometry.grew, start_tip ? &prepended : nullptr);
+          check_crack_update(geometry.crack_id, crack->wings ? crack->wings->ids() : crack->solver.grid().ids(),
+                             geometry.ids, &geometry.grew, start_tip ? &prepended : nullptr);
         }
         if (crack->wings && had_grid && geometry.inlet_id != crack->wings->inlet_id()) {
           throw std::invalid_argument("crack " + std::to_string(geometry.crack_id) + ": inlet_id changed from " +
@@ -216,23 +216,23 @@ class MpmFluidSide final : public coupling::SideModel {
           static_cast<unsigned long long>(steps_));
     }
     for (const auto& c : cracks_) {
-     for (const auto* solver : c.solvers()) {
-      const auto& s = *solver;
-      if (!config_.implicit_interface || s.steps() == 0) continue;
-      std::fprintf(stderr,
-                   "hfmpm-fluid: crack %u: %llu implicit steps, %.2f Newton iterations per step, %llu particles "
-                   "merged before a step; %llu solves finished by the careful Jacobian, %llu stopped above "
-                   "tolerance (committed if no element misfit exceeds 1e-8 of the fluid, else retried): %llu steps "
-                   "taken in fluid substeps (at most %llu), %llu taken whole above the bound after every retry\n",
-                   c.id, static_cast<unsigned long long>(s.steps()),
-                   static_cast<double>(s.interface_newton_total()) / static_cast<double>(s.steps()),
-                   static_cast<unsigned long long>(s.interface_merges()),
-                   static_cast<unsigned long long>(s.interface_rescued()),
-                   static_cast<unsigned long long>(s.interface_unconverged_steps()),
-                   static_cast<unsigned long long>(s.interface_subcycled_steps()),
-                   static_cast<unsigned long long>(s.interface_max_substeps()),
-                   static_cast<unsigned long long>(s.interface_committed_above_bound()));
-     }
+      for (const auto* solver : c.solvers()) {
+        const auto& s = *solver;
+        if (!config_.implicit_interface || s.steps() == 0) continue;
+        std::fprintf(stderr,
+                     "hfmpm-fluid: crack %u: %llu implicit steps, %.2f Newton iterations per step, %llu particles "
+                     "merged before a step; %llu solves finished by the careful Jacobian, %llu stopped above "
+                     "tolerance (committed if no element misfit exceeds 1e-8 of the fluid, else retried): %llu steps "
+                     "taken in fluid substeps (at most %llu), %llu taken whole above the bound after every retry\n",
+                     c.id, static_cast<unsigned long long>(s.steps()),
+                     static_cast<double>(s.interface_newton_total()) / static_cast<double>(s.steps()),
+                     static_cast<unsigned long long>(s.interface_merges()),
+                     static_cast<unsigned long long>(s.interface_rescued()),
+                     static_cast<unsigned long long>(s.interface_unconverged_steps()),
+                     static_cast<unsigned long long>(s.interface_subcycled_steps()),
+                     static_cast<unsigned long long>(s.interface_max_substeps()),
+                     static_cast<unsigned long long>(s.interface_committed_above_bound()));
+      }
     }
   }
 
@@ -294,7 +294,8 @@ class MpmFluidSide final : public coupling::SideModel {
     }
   };
 
-  // The retried implicit steps of one solver, the first kReportedRetries times (fluid.log; the count is in the summary).
+  // The retried implicit steps of one solver, the first kReportedRetries times (fluid.log; the count is in the
+  // summary).
   void report_retries(std::uint32_t id, const mpm::FluidSolver& s, double dt) {
     if (config_.implicit_interface && s.interface_last_above_bound() && above_reported_++ < kReportedRetries) {
       std::fprintf(stderr,
@@ -364,9 +365,7 @@ class MpmFluidSide final : public coupling::SideModel {
       throw coupling::InputError(std::string("fluid.mpm.initial_fill: ") + e.what());
     }
   }
-  std::uint64_t steps_of_first() const {
-    return cracks_.empty() ? 0 : cracks_.front().solvers().front()->steps();
-  }
+  std::uint64_t steps_of_first() const { return cracks_.empty() ? 0 : cracks_.front().solvers().front()->steps(); }
 
   mpm::FluidConfig config_;
   std::set<std::uint32_t> listed_;
@@ -376,8 +375,9 @@ class MpmFluidSide final : public coupling::SideModel {
   bool received_ = false;
   std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
   static constexpr int kReportedRetries = 20;
-  int retries_reported_ = 0, above_reported_ = 0, junction_reported_ = 0;  // subcycled implicit steps written to the log (not checkpointed)
-  output::SideFrames frames_;                      // the frame file (solid.h5 / fluid.h5) across restarts
+  int retries_reported_ = 0, above_reported_ = 0,
+      junction_reported_ = 0;  // subcycled implicit steps written to the log (not checkpointed)
+  output::SideFrames frames_;  // the frame file (solid.h5 / fluid.h5) across restarts
 };
 
 }  // namespace

@@ -105,7 +105,8 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   if (s.solid().has_mpm() && s.coupling().scheme() != scene::Coupling::IMPLICIT) {
     for (int i = 0; i < s.solid().mpm().cracks_size(); ++i) {
       if (!s.solid().mpm().cracks(i).has_inlet_vertex()) continue;
-      c.bad("solid.mpm.cracks[" + std::to_string(i) + "].inlet_vertex", std::to_string(s.solid().mpm().cracks(i).inlet_vertex()),
+      c.bad("solid.mpm.cracks[" + std::to_string(i) + "].inlet_vertex",
+            std::to_string(s.solid().mpm().cracks(i).inlet_vertex()),
             "coupling.scheme: IMPLICIT with an inlet vertex (the fluid's two wings keep one pressure where they "
             "meet only under the implicit interface step); or, under another scheme, a crack with a mouth "
             "(start_is_tip: false, no inlet_vertex) on a symmetry plane");

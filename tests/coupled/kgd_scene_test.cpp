@@ -226,9 +226,10 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
       ++frames;
     }
     ASSERT_GE(frames, 5);
-    std::printf("wings at the end: %.4f m and %.4f m from the inlet; from three notch lengths on (%d frames) "
-                "they differ by %.4f of their mean on average and by at most %.4f m\n",
-                wings.back().first, wings.back().second, frames, sum / frames, worst);
+    std::printf(
+        "wings at the end: %.4f m and %.4f m from the inlet; from three notch lengths on (%d frames) "
+        "they differ by %.4f of their mean on average and by at most %.4f m\n",
+        wings.back().first, wings.back().second, frames, sum / frames, worst);
     EXPECT_LT(sum / frames, bounds.apart);
     // Growth steps are cut in the deformed body, whose strain (the confining
     // stress over E: 1%) stretches them: 2% allowed on top.
@@ -275,8 +276,9 @@ TEST(KgdScene, ViscosityCiSceneFollowsTheMVertex) {
 TEST(KgdScene, TwoWingCiSceneFollowsTheMVertexWithEqualWings) {
   Bounds bounds{0.06, 0.05, 0.12, 1e-4};
   bounds.wings = 2;
-  expect_ci_scene_follows("scenarios/kgd-two-wing-ci.scene", 2.5e-4,
-                          [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9, {}, bounds);
+  expect_ci_scene_follows(
+      "scenarios/kgd-two-wing-ci.scene", 2.5e-4, [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9, {},
+      bounds);
 }
 
 // The same with the former defaults: the tip-asymptote closure (lag

@@ -210,6 +210,17 @@ TEST(Restart, ImplicitAndJacobiSchemesContinueBitForBit) {
       dir + "/jacobi");
 }
 
+// A crack entered inside the body (kgd-two-wing-ci, to 1 s): the fluid's two
+// wings and their junction, the solid's wetted interval and both tips'
+// growth waits go through a checkpoint; restarted at 0.4 s, the run passes
+// the first growth of both tips (0.5-0.75 s) as the uninterrupted one did.
+TEST(Restart, TwoWingCrackContinuesBitForBit) {
+  expect_continued_run_equal(
+      {bin("hfmpm"), "run", source("scenarios/kgd-two-wing-ci.scene"), "--set", "time.end_s=1", "--set",
+       "output.interval_s=0.1", "--set", "output.checkpoint_interval_s=0.4", "--set", "output.exchange_log=true"},
+      scratch_dir("restart-two-wing"));
+}
+
 // `hfmpm coupler --restart DIR` with the sides started by hand: the coupler
 // continues from its checkpoint, each side reads its own file under its output
 // directory (here the coupler's, from the Welcome), and the run ends as the

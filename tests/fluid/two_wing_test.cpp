@@ -144,7 +144,7 @@ TEST(TwoWingFluid, SharesTheFlowSoThatTheWingsHoldOnePressure) {
   EXPECT_LT(worst_share, 0.01);
   EXPECT_NEAR(m1 / m0, 2.0, 2e-3);
   EXPECT_NEAR(fluid.transfer(), fluid.share() * kQ - 0.5 * kQ, 1e-12);  // the share is Q / 2 + the transfer
-  EXPECT_GT(fluid.inlet_pressure(), 0.05 * c.bulk_modulus);  // the fluid was compressed (~9%)
+  EXPECT_GT(fluid.inlet_pressure(), 0.05 * c.bulk_modulus);             // the fluid was compressed (~9%)
   EXPECT_EQ(fluid.unconverged_steps(), 0u);
 }
 

@@ -40,7 +40,7 @@ CrackGeometry wing_geometry(const CrackGeometry& whole, std::size_t inlet, bool 
     g.position.push_back(whole.position[k]);
     g.normal.push_back(turn * whole.normal[k]);
     g.width.push_back(whole.width[k]);
-    g.tip.push_back(i == 0 ? 0 : whole.tip[k]);
+    g.tip.push_back(i == 0 ? char{0} : whole.tip[k]);
   }
   if (whole.opening_rate.empty()) return g;
   const std::size_t B = whole.compliance_band, row = 2 * B + 1;
@@ -236,8 +236,7 @@ void TwoWingFluid::load(const StateReader& in) {
   inlet_ = static_cast<std::size_t>(inlet);
   whole_.position = positions_;
   if (whole_.width.size() != whole_.ids.size() || arc_.size() != whole_.ids.size() ||
-      positions_.size() != whole_.ids.size() || inlet_ + 1 >= arc_.size() ||
-      inlet_ == 0) {
+      positions_.size() != whole_.ids.size() || inlet_ + 1 >= arc_.size() || inlet_ == 0) {
     throw std::runtime_error("checkpoint: the two-wing fluid's crack arrays differ in size or its inlet is not inner");
   }
   in.get("transfer", transfer_);

@@ -68,8 +68,8 @@ struct CrackPressure {
   // > 0 for an interior inlet whose start-side wing has not reached the start).
   double front_position = 0;
   double front_start_position = 0;
-  double inlet_flux = 0;      // m^2/s
-  double fluid_volume = 0;    // m^2
+  double inlet_flux = 0;    // m^2/s
+  double fluid_volume = 0;  // m^2
 
   std::size_t size() const { return ids.size(); }
 };

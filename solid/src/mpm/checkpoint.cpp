@@ -209,7 +209,8 @@ void Solver::load(const StateReader& in) {
   std::vector<double> arrived;
   in.get("front_arrived_at", arrived);
   front_arrived_at_.resize(arrived.size() / 2);
-  for (std::size_t i = 0; i < front_arrived_at_.size(); ++i) front_arrived_at_[i] = {arrived[2 * i], arrived[2 * i + 1]};
+  for (std::size_t i = 0; i < front_arrived_at_.size(); ++i)
+    front_arrived_at_[i] = {arrived[2 * i], arrived[2 * i + 1]};
   in.get("anchored_at", anchored_at_);
   std::vector<double> drift;
   in.get("surface_drift", drift);

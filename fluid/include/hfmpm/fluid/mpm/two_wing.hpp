@@ -79,7 +79,7 @@ class TwoWingFluid {
   // nodes, the inlet's value the mean of the two; 0 where a wing has none.
   std::vector<double> join(const std::vector<double>& wing0, const std::vector<double>& wing1) const;
   const std::vector<Vec2>& positions() const { return positions_; }  // m, the whole crack's nodes
-  const std::vector<double>& arc() const { return arc_; }              // m, their arc lengths
+  const std::vector<double>& arc() const { return arc_; }            // m, their arc lengths
   std::size_t inlet_index() const { return inlet_; }
   const std::vector<std::uint64_t>& ids() const { return whole_.ids; }  // the whole crack's, as last set
   std::uint64_t inlet_id() const { return whole_.inlet_id; }
@@ -87,7 +87,7 @@ class TwoWingFluid {
   // inlet's); and the share of the inflow that wing 1 took (1/2 without inflow).
   double transfer() const { return transfer_; }
   double share() const;
-  double inlet_pressure() const;           // Pa, the mean of the wings'
+  double inlet_pressure() const;  // Pa, the mean of the wings'
   // Pa, the wings' inlet pressures' difference after the last step.
   double junction_mismatch() const { return mismatch_; }
   int last_iterations() const { return last_iterations_; }

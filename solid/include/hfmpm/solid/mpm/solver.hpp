@@ -246,7 +246,7 @@ class Solver {
   // s, when the fluid front came within the end tip's allowed lag (-inf: not
   // since its last growth); Fracture::front_settle_transits.
   std::vector<std::array<double, 2>> front_arrived_at_;  // s, per crack (start, end) tip
-  double anchored_at_ = -1;  // s, when anchor_crack_surfaces last ran (-1: not yet)
+  double anchored_at_ = -1;                              // s, when anchor_crack_surfaces last ran (-1: not yet)
   // Per crack and crack particle, the drift velocity (m/s) of its surface
   // above and below toward the material's opening over the step begun
   // (anchor_crack_surfaces; empty without surfaces_from_material).
