@@ -201,17 +201,71 @@ CrackPressure TwoWingFluid::pressure_message() const {
   return m;
 }
 
+namespace {
+
+// The whole crack as last set, response included: a checkpoint falls
+// between set_crack() and advance(), and the step after a restart must see
+// the crack the uninterrupted run saw.
+void save_geometry(StateWriter& out, const CrackGeometry& g) {
+  out.put("crack_id", g.crack_id);
+  out.put("ids", g.ids);
+  out.put("position", g.position);
+  out.put("normal", g.normal);
+  out.put("width", g.width);
+  out.put("tip", std::vector<std::uint64_t>(g.tip.begin(), g.tip.end()));
+  out.put("grew", static_cast<int>(g.grew));
+  out.put("opening_rate", g.opening_rate);
+  out.put("opening_acceleration", g.opening_acceleration);
+  out.put("opening_compliance", g.opening_compliance);
+  out.put("compliance_band", g.compliance_band);
+  out.put("plane_rate", g.plane_rate);
+  out.put("plane_acceleration", g.plane_acceleration);
+  out.put("tip_modulus", g.tip_modulus);
+  out.put("resolution", g.resolution);
+  out.put("inlet_id", g.inlet_id);
+  out.put("start_tip_modulus", g.start_tip_modulus);
+}
+
+void load_geometry(const StateReader& in, CrackGeometry& g) {
+  in.get("crack_id", g.crack_id);
+  in.get("ids", g.ids);
+  in.get("position", g.position);
+  in.get("normal", g.normal);
+  in.get("width", g.width);
+  std::vector<std::uint64_t> tip;
+  in.get("tip", tip);
+  g.tip.assign(tip.begin(), tip.end());
+  int grew = 0;
+  in.get("grew", grew);
+  g.grew = grew != 0;
+  in.get("opening_rate", g.opening_rate);
+  in.get("opening_acceleration", g.opening_acceleration);
+  in.get("opening_compliance", g.opening_compliance);
+  in.get("compliance_band", g.compliance_band);
+  in.get("plane_rate", g.plane_rate);
+  in.get("plane_acceleration", g.plane_acceleration);
+  in.get("tip_modulus", g.tip_modulus);
+  in.get("resolution", g.resolution);
+  in.get("inlet_id", g.inlet_id);
+  in.get("start_tip_modulus", g.start_tip_modulus);
+  g.has_inlet = true;
+  const std::size_t n = g.ids.size();
+  if (g.position.size() != n || g.normal.size() != n || g.width.size() != n || g.tip.size() != n) {
+    throw std::runtime_error("checkpoint: the two-wing fluid's crack arrays differ in size");
+  }
+}
+
+}  // namespace
+
 void TwoWingFluid::save(StateWriter& out) const {
   for (std::size_t w = 0; w < 2; ++w) {
     PrefixedWriter wing(out, "wing" + std::to_string(w) + ".");
     wings_[w].save(wing);
+    PrefixedWriter before(out, "before" + std::to_string(w) + ".");
+    before_[w].save(before);
   }
-  out.put("whole.crack_id", whole_.crack_id);
-  out.put("whole.ids", whole_.ids);
-  out.put("whole.inlet_id", whole_.inlet_id);
-  out.put("whole.width", whole_.width);
-  out.put("whole.arc", arc_);
-  out.put("whole.position", positions_);
+  PrefixedWriter whole(out, "whole.");
+  save_geometry(whole, whole_);
   out.put("inlet", static_cast<std::uint64_t>(inlet_));
   out.put("transfer", transfer_);
   out.put("slope", slope_);
@@ -222,23 +276,18 @@ void TwoWingFluid::save(StateWriter& out) const {
 }
 
 void TwoWingFluid::load(const StateReader& in) {
-  for (std::size_t w = 0; w < 2; ++w) wings_[w].load(PrefixedReader(in, "wing" + std::to_string(w) + "."));
-  before_ = wings_;
-  in.get("whole.crack_id", whole_.crack_id);
-  in.get("whole.ids", whole_.ids);
-  in.get("whole.inlet_id", whole_.inlet_id);
-  whole_.has_inlet = true;
-  in.get("whole.width", whole_.width);
-  in.get("whole.arc", arc_);
-  in.get("whole.position", positions_);
+  for (std::size_t w = 0; w < 2; ++w) {
+    wings_[w].load(PrefixedReader(in, "wing" + std::to_string(w) + "."));
+    before_[w].load(PrefixedReader(in, "before" + std::to_string(w) + "."));
+  }
+  load_geometry(PrefixedReader(in, "whole."), whole_);
   std::uint64_t inlet = 0;
   in.get("inlet", inlet);
   inlet_ = static_cast<std::size_t>(inlet);
-  whole_.position = positions_;
-  if (whole_.width.size() != whole_.ids.size() || arc_.size() != whole_.ids.size() ||
-      positions_.size() != whole_.ids.size() || inlet_ + 1 >= arc_.size() || inlet_ == 0) {
-    throw std::runtime_error("checkpoint: the two-wing fluid's crack arrays differ in size or its inlet is not inner");
-  }
+  if (inlet_ == 0 || inlet_ + 1 >= whole_.size())
+    throw std::runtime_error("checkpoint: the two-wing fluid's inlet is not an inner particle");
+  arc_ = arc_length(whole_.position);
+  positions_ = whole_.position;
   in.get("transfer", transfer_);
   in.get("slope", slope_);
   in.get("mismatch", mismatch_);
