@@ -117,7 +117,8 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
   t.b.resize(np);
   t.mass.assign(part.mass.begin(), part.mass.end());
   for (std::size_t p = 0; p < np; ++p) {
-    t.a[p] = part.start(p) + dt * interpolate(arc, t.v, part.start(p));
+    // A particle starts where the one before it ends (FluidParticles::contiguous).
+    t.a[p] = p == 0 ? part.start(p) + dt * interpolate(arc, t.v, part.start(p)) : t.b[p - 1];
     t.b[p] = moved_end(p + 1 == np, part.end(p), t.a[p], part.end(p) + dt * interpolate(arc, t.v, part.end(p)), arc,
                        t.width, t.mass[p] / rho0);
     if (!(t.b[p] > t.a[p])) {

@@ -306,9 +306,11 @@ std::vector<double> FluidSolver::implicit_substep(double h, double tau, bool las
   // with it (as set_crack does with the crack the solid publishes).
   const std::vector<double> from = grid_.arc();
   grid_.move(x.empty() ? grid_.position() : x, trial.opened);
+  double previous = 0;  // the end of the particle before (FluidParticles::contiguous)
   for (std::size_t p = 0; p < particles_.size(); ++p) {
-    const double a = map_arc(particles_.start(p), from, grid_.arc());
+    const double a = p == 0 ? map_arc(particles_.start(p), from, grid_.arc()) : previous;
     const double b = map_arc(particles_.end(p), from, grid_.arc());
+    previous = b;
     particles_.f11[p] *= (b - a) / particles_.length[p];
     particles_.s[p] = 0.5 * (a + b);
     particles_.length[p] = b - a;

@@ -61,9 +61,11 @@ void FluidSolver::set_crack(const CrackGeometry& crack) {
       if (extended && s > old_arc[m - 2]) return std::min(moved[m - 2] + (s - old_arc[m - 2]), moved[m - 1]);
       return map_arc(s, old_arc, moved);
     };
+    double previous = 0;  // the end of the particle before (FluidParticles::contiguous)
     for (std::size_t p = 0; p < particles_.size(); ++p) {
-      const double a = carry(particles_.start(p));
+      const double a = p == 0 ? carry(particles_.start(p)) : previous;
       const double b = carry(particles_.end(p));
+      previous = b;
       particles_.f11[p] *= (b - a) / particles_.length[p];
       particles_.s[p] = 0.5 * (a + b);
       particles_.length[p] = b - a;
@@ -360,6 +362,7 @@ void FluidSolver::g2p(double dt) {
   auto& P = particles_;
   const auto& arc = grid_.arc();
   const double flip = config_.flip;
+  double previous = 0;  // the end of the particle before, where this one starts (FluidParticles::contiguous)
   for (std::size_t p = 0; p < P.size(); ++p) {
     const CpdiRange r = shapes_.range[p];
     const double* N = shapes_.weight.data() + shapes_.offset[p];
@@ -373,9 +376,10 @@ void FluidSolver::g2p(double dt) {
     P.velocity[p] = (1 - flip) * pic + flip * (P.velocity[p] + change);
     P.gradient[p] = config_.affine ? gradient : 0.0;  // the mean of dv/ds over the domain
     // CPDI corner update: both ends move with the grid velocity there.
-    const double a = P.start(p) + dt * interpolate(arc, v_new_, P.start(p));
+    const double a = p == 0 ? P.start(p) + dt * interpolate(arc, v_new_, P.start(p)) : previous;
     const double b = moved_end(p + 1 == P.size(), P.end(p), a, P.end(p) + dt * interpolate(arc, v_new_, P.end(p)), arc,
                                grid_.width(), P.mass[p] / config_.density);
+    previous = b;
     if (!(b > a)) {
       std::ostringstream out;
       out << "fluid: particle " << p << " at s = " << P.s[p] << " m turned inside out in a step of " << dt

@@ -34,6 +34,13 @@ struct FluidParticles {
   std::vector<double> pressure;  // Pa, >= 0 (no tension)
 
   std::size_t size() const { return s.size(); }
+  // Contiguous: particle p + 1 starts where p ends. The solver moves that
+  // shared end once, as p's end, and starts p + 1 there: moved as two ends,
+  // the round-off between s + l/2 and the next s - l/2 (1e-10 m) grew by the
+  // stretching at a front by a factor of 1000 in 200 steps and then ran away,
+  // leaving two particles on top of each other moving at 100-300 m/s without
+  // going anywhere, and the advective step 180 times shorter (the robustness
+  // matrix's field-km100, docs/verification.md).
   double start(std::size_t p) const { return s[p] - 0.5 * length[p]; }  // m, rear end
   double end(std::size_t p) const { return s[p] + 0.5 * length[p]; }    // m, front end
   double volume(std::size_t p) const { return length[p] * width[p]; }   // m^2
