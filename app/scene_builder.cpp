@@ -313,12 +313,17 @@ BuiltScene build_scene(const problem::Problem& p) {
   const int near_y = std::min(ny, static_cast<int>(std::ceil(l_end / h)));
   const double near_body_x = near_x * h, near_body_y = (near_y + 0.5) * h;
 
+  const bool both = p.injection().both_wings();  // a well inside the body: the whole body, both wings
+  const double wing_q = both ? q : 0.5 * q;      // m^2/s into the modelled crack
   std::ostringstream s;
   const std::string regime =
       d.viscosity_dominated ? "viscosity-dominated (M-vertex)" : "toughness-dominated (K-vertex)";
   s << "# Built by `hfmpm scene` from the problem '" << p.name() << "' (physics only; docs/scenes.md,\n"
     << "# \"A scene from physics alone\"). Every numerical setting below is derived from the\n"
     << "# physics, with its reason; any of them can still be overridden with --set.\n"
+    << (both ? "#   both wings: the whole body, no symmetry plane; the fluid enters at the notch's centre\n"
+               "#   (a well inside the body; docs/fluid.md, \"Injection from inside the body\").\n"
+             : "")
     << "#   E' = " << approx(d.e_prime) << " Pa, Km = " << approx(d.km) << ": " << regime << ".\n"
     << "#   Expected at the end (the " << (d.viscosity_dominated ? "M" : "K")
     << "-vertex, time less half the ramp): half-length " << approx(l_end) << " m,\n"
@@ -365,23 +370,24 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "output { interval_s: " << num(t_end / 20) << " }\n"
     << "coupling { transport: IPC scheme: IMPLICIT exchange_interval: 1 control_interval: 20 }\n"
     << "solid {\n  mpm {\n"
-    << "    grid { x_min_m: 0 y_min_m: " << exact(-grid_y) << " x_max_m: " << exact(grid_x)
-    << " y_max_m: " << exact(grid_y) << " }\n"
+    << "    grid { x_min_m: " << (both ? exact(-grid_x) : "0") << " y_min_m: " << exact(-grid_y)
+    << " x_max_m: " << exact(grid_x) << " y_max_m: " << exact(grid_y) << " }\n"
     << "    cell_size_m: " << exact(h) << "\n"
     << "    materials { name: \"rock\" youngs_modulus_pa: " << num(e) << " poisson_ratio: " << num(nu)
     << " density_kg_m3: " << num(density) << " toughness_pa_sqrt_m: " << num(rock.toughness_pa_sqrt_m()) << " }\n";
   const std::string stress = "initial_stress { xx_pa: " + num(-sigma_a) + " yy_pa: " + num(-sigma_n) + " }";
-  s << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << exact(-body_y)
-    << " x_max_m: " << exact(body_x) << " y_max_m: " << exact(body_y) << " }\n              " << stress
-    << " particles_per_cell: 1 }\n"
-    << "    regions { material: \"rock\" rectangle { x_min_m: 0 y_min_m: " << exact(-near_body_y)
-    << " x_max_m: " << exact(near_body_x) << " y_max_m: " << exact(near_body_y) << " }\n              " << stress
-    << " particles_per_cell: 2 }\n"
-    << "    constraints { symmetry_x_m: 0 }\n"
+  s << "    regions { material: \"rock\" rectangle { x_min_m: " << (both ? exact(-body_x) : "0")
+    << " y_min_m: " << exact(-body_y) << " x_max_m: " << exact(body_x) << " y_max_m: " << exact(body_y)
+    << " }\n              " << stress << " particles_per_cell: 1 }\n"
+    << "    regions { material: \"rock\" rectangle { x_min_m: " << (both ? exact(-near_body_x) : "0")
+    << " y_min_m: " << exact(-near_body_y) << " x_max_m: " << exact(near_body_x) << " y_max_m: " << exact(near_body_y)
+    << " }\n              " << stress << " particles_per_cell: 2 }\n"
+    << (both ? "    tractions { edge: LEFT normal_pa { constant: " + num(-sigma_a) + " } }\n"
+             : std::string("    constraints { symmetry_x_m: 0 }\n"))
     << "    tractions { edge: RIGHT normal_pa { constant: " << num(-sigma_a) << " } }\n"
     << "    tractions { edge: TOP normal_pa { constant: " << num(-sigma_n) << " } }\n"
     << "    tractions { edge: BOTTOM normal_pa { constant: " << num(-sigma_n) << " } }\n"
-    << "    silent_edges: [RIGHT, TOP, BOTTOM]\n"
+    << (both ? "    silent_edges: [LEFT, RIGHT, TOP, BOTTOM]\n" : "    silent_edges: [RIGHT, TOP, BOTTOM]\n")
     << "    density_scaling: " << num(d.density_scaling) << "\n"
     << "    in_situ_reference: true\n"
     << "    damping { grid_alpha_per_s: " << num(d.damping) << " pic_fraction: 0.5 }\n"
@@ -389,15 +395,17 @@ BuiltScene build_scene(const problem::Problem& p) {
     << " check_interval: 2 direction: STRAIGHT\n               max_lag_cells: " << num(growth)
     << (settle > 0 ? " settle_transits: 2" : "") << " surfaces_from_material: true"
     << " }\n"
-    << "    cracks { x_m: [0, " << num(p.notch_m()) << "] y_m: [0, 0] start_is_tip: false end_is_tip: true }\n"
+    << (both ? "    cracks { x_m: [" + num(-p.notch_m()) + ", 0, " + num(p.notch_m()) +
+                   "] y_m: [0, 0, 0] start_is_tip: true end_is_tip: true inlet_vertex: 1 }   # the well at x = 0\n"
+             : "    cracks { x_m: [0, " + num(p.notch_m()) + "] y_m: [0, 0] start_is_tip: false end_is_tip: true }\n")
     << "  }\n}\n"
     << "fluid {\n  mpm {\n"
     << "    density_kg_m3: " << num(fluid.density_kg_m3()) << "\n"
     << "    bulk_modulus_pa: " << num(fluid.bulk_modulus_pa()) << "\n"
     << "    viscosity_pa_s: " << num(fluid.viscosity_pa_s()) << "\n"
     << "    inlet { flow_rate_m2_s { "
-    << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(0.5 * q) + " }" : "constant: " + num(0.5 * q))
-    << " } }   # one wing: half the total rate\n"
+    << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(wing_q) + " }" : "constant: " + num(wing_q))
+    << (both ? " } }   # both wings: the total rate\n" : " } }   # one wing: half the total rate\n")
     << "    initial_fill { front_m: " << num(p.notch_m()) << " pressure_pa: " << num(sigma_n) << " }\n"
     << "    virtual_opening_m: " << num(d.virtual_opening) << "\n";
   if (d.matched_closure) {

@@ -90,14 +90,14 @@ def expected_length(c):
     return min(m[0], k[0])
 
 
-def problem_text(c):
+def problem_text(c, both_wings=False):
     notch = expected_length(c) / 6
     return (f'name: "{c["name"]}"\n'
             f'rock {{ youngs_modulus_pa: {c["E"]:.6g} poisson_ratio: {c["nu"]:.6g} density_kg_m3: {c["rho"]:.6g} '
             f'toughness_pa_sqrt_m: {c["KIc"]:.6g} }}\n'
             f'in_situ {{ normal_to_crack_pa: {c["sigma"]:.6g} }}\n'
             f'fluid {{ viscosity_pa_s: {c["mu"]:.6g} }}\n'
-            f'injection {{ total_rate_m2_s: {c["Q"]:.6g} }}\n'
+            f'injection {{ total_rate_m2_s: {c["Q"]:.6g}{" both_wings: true" if both_wings else ""} }}\n'
             f'duration_s: {c["t"]:.6g}\n'
             f'notch_m: {notch:.6g}\n')
 
@@ -114,6 +114,8 @@ def judge(run, c, reference="transition"):
     vertex of an M or K case (kgd_plot.vertices(); MK cases still against the transition)."""
     p = kgd_plot.scene_parameters(run)
     h = kgd_plot.read_history(os.path.join(run, "history.csv"))
+    if p.get("two_wing"):  # both wings modelled: the half-length is half the crack
+        h["crack_length_m"] = [0.5 * v for v in h["crack_length_m"]]
     km = kgd_plot.km(p["E"], p["nu"], p["mu"], p["Q"], p["KIc"])
     label = regime(km)
     worst = [0.0] * 4
@@ -148,6 +150,8 @@ def main():
                     help="judge against the transition solution at each Km (default) or, for M and K cases, "
                          "the vertex (kgd_plot.vertices())")
     ap.add_argument("--list", action="store_true", help="print the cases and stop")
+    ap.add_argument("--both-wings", action="store_true",
+                    help="build every case with both wings and a well inside the body (injection.both_wings)")
     a = ap.parse_args()
     todo = cases()
     if a.list:
@@ -171,7 +175,7 @@ def main():
         if c["name"] in done and not a.force:
             continue
         base = os.path.join(a.out, "cases", c["name"])
-        text = problem_text(c)
+        text = problem_text(c, a.both_wings)
         if a.cells:
             text += f"accuracy {{ cells_per_half_length: {a.cells:g} }}\n"
         with open(base + ".problem", "w") as f:

@@ -126,6 +126,42 @@ TEST(SceneBuilder, ViscosityDominatedSceneFollowsItsDerivation) {
   EXPECT_THAT(built.text, HasSubstr("Km = 0.023: viscosity-dominated"));
 }
 
+// injection.both_wings: a well inside the body. The same numerical choices
+// as the one-wing scene; the whole body mirrored about the well (no symmetry
+// plane, the far edge's traction and silent boundary on the left too), the
+// notch notch_m each way with the fluid entering at its centre, the total
+// rate. Built robustness-matrix cases run within issue 19's bounds
+// (docs/verification.md, "Injection from inside the body").
+TEST(SceneBuilder, BothWingsMirrorTheBodyAboutTheWell) {
+  const BuiltScene one = build_scene(field_problem());
+  problem::Problem p = field_problem();
+  p.mutable_injection()->set_both_wings(true);
+  const BuiltScene built = build_scene(p);
+  const scene::Scene s = checked(built), w = checked(one);
+  const auto& mpm = s.solid().mpm();
+  EXPECT_EQ(mpm.cell_size_m(), w.solid().mpm().cell_size_m());
+  EXPECT_EQ(mpm.density_scaling(), w.solid().mpm().density_scaling());
+  EXPECT_EQ(mpm.damping().grid_alpha_per_s(), w.solid().mpm().damping().grid_alpha_per_s());
+  EXPECT_EQ(mpm.grid().x_min_m(), -w.solid().mpm().grid().x_max_m());
+  EXPECT_EQ(mpm.grid().x_max_m(), w.solid().mpm().grid().x_max_m());
+  for (int r = 0; r < 2; ++r)
+    EXPECT_EQ(mpm.regions(r).rectangle().x_min_m(), -mpm.regions(r).rectangle().x_max_m()) << "region " << r;
+  EXPECT_EQ(mpm.constraints_size(), 0);  // no symmetry plane
+  EXPECT_EQ(mpm.silent_edges_size(), 4);
+  ASSERT_EQ(mpm.cracks_size(), 1);
+  const auto& crack = mpm.cracks(0);
+  EXPECT_TRUE(crack.start_is_tip() && crack.end_is_tip());
+  ASSERT_TRUE(crack.has_inlet_vertex());
+  EXPECT_EQ(crack.inlet_vertex(), 1u);
+  ASSERT_EQ(crack.x_m_size(), 3);
+  EXPECT_DOUBLE_EQ(crack.x_m(0), -2);
+  EXPECT_DOUBLE_EQ(crack.x_m(1), 0);
+  EXPECT_DOUBLE_EQ(crack.x_m(2), 2);
+  // Both wings: the total rate.
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().inlet().flow_rate_m2_s().ramp().v1(), 2e-5);
+  EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);  // which a well inside the body needs
+}
+
 TEST(SceneBuilder, ToughnessDominatedSceneTakesTheToughnessClosure) {
   const BuiltScene built = build_scene(toughness_problem());
   const scene::Scene s = checked(built);
