@@ -104,7 +104,6 @@ void TwoWingFluid::set_crack(const CrackGeometry& crack) {
   whole_ = crack;
   inlet_ = inlet;
   arc_ = arc_length(crack.position);
-  positions_ = crack.position;
   // The pressures across the inlet after the last step, on the new crack
   // (the wings count from the inlet, so growth at either end keeps them in place).
   const std::vector<double> across = wings_[0].grid().empty() ? std::vector<double>{} : merged(wings_);
@@ -115,13 +114,13 @@ void TwoWingFluid::set_crack(const CrackGeometry& crack) {
 void TwoWingFluid::fill(double front, double pressure) {
   if (wings_[0].grid().empty()) throw std::logic_error("fluid: set_crack() must be called before fill()");
   for (auto& w : wings_) w.fill(std::min(front, w.grid().length()), pressure);
-  // A later iteration of the first step starts from here (set to the crack
-  // already; setting it again to the same crack moves nothing).
+  // A later iteration of the first step starts from here: set to the crack
+  // already, and set again to the same crack its particles move by round-off only.
   before_ = wings_;
 }
 
 int TwoWingFluid::advance(double dt) {
-  const bool implicit = wings_[0].config().implicit_interface && !whole_.opening_rate.empty();
+  const bool response = !whole_.opening_rate.empty();  // the faces' response couples the wings across the inlet
   int steps = 0;
   std::array<FluidSolver, 2> trial = wings_;  // set with the loads across from the step before
   std::vector<double> across = merged(before_);
@@ -139,7 +138,7 @@ int TwoWingFluid::advance(double dt) {
     const std::vector<double> found = merged(trial);
     double change = 0, largest = std::max(p0, p1);
     for (double p : found) largest = std::max(largest, p);
-    if (implicit) {
+    if (response) {
       const std::size_t B = whole_.compliance_band;
       const std::size_t lo = inlet_ >= B ? inlet_ - B : 0, hi = std::min(found.size() - 1, inlet_ + B);
       for (std::size_t j = lo; j <= hi; ++j) {
@@ -187,12 +186,7 @@ CrackPressure TwoWingFluid::pressure_message() const {
   CrackPressure m;
   m.crack_id = whole_.crack_id;
   m.ids = whole_.ids;
-  m.pressure = merged(wings_);
-  if (!wings_[0].config().implicit_interface) {
-    // -dp/dw from each wing (the inlet's the mean), at the widths they used.
-    m.stiffness = join(wings_[0].nodal_stiffness(), wings_[1].nodal_stiffness());
-    m.width = whole_.width;
-  }
+  m.pressure = merged(wings_);  // the implicit step's pressures already follow the faces: no stiffness
   const double at = arc_.empty() ? 0.0 : arc_[inlet_];
   m.front_position = at + wings_[1].front_position();
   m.front_start_position = std::max(0.0, at - wings_[0].front_position());
@@ -287,7 +281,6 @@ void TwoWingFluid::load(const StateReader& in) {
   if (inlet_ == 0 || inlet_ + 1 >= whole_.size())
     throw std::runtime_error("checkpoint: the two-wing fluid's inlet is not an inner particle");
   arc_ = arc_length(whole_.position);
-  positions_ = whole_.position;
   in.get("transfer", transfer_);
   in.get("slope", slope_);
   in.get("mismatch", mismatch_);

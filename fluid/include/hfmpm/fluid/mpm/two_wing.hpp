@@ -78,8 +78,8 @@ class TwoWingFluid {
   // A per-node array of each wing (nodes from the inlet) on the whole crack's
   // nodes, the inlet's value the mean of the two; 0 where a wing has none.
   std::vector<double> join(const std::vector<double>& wing0, const std::vector<double>& wing1) const;
-  const std::vector<Vec2>& positions() const { return positions_; }  // m, the whole crack's nodes
-  const std::vector<double>& arc() const { return arc_; }            // m, their arc lengths
+  const std::vector<Vec2>& positions() const { return whole_.position; }  // m, the whole crack's nodes
+  const std::vector<double>& arc() const { return arc_; }                 // m, their arc lengths
   std::size_t inlet_index() const { return inlet_; }
   const std::vector<std::uint64_t>& ids() const { return whole_.ids; }  // the whole crack's, as last set
   std::uint64_t inlet_id() const { return whole_.inlet_id; }
@@ -106,7 +106,6 @@ class TwoWingFluid {
   std::array<FluidSolver, 2> before_;  // the wings before the last set_crack (each iteration starts there)
   CrackGeometry whole_;                // the crack as last set
   std::vector<double> arc_;            // m, its arc lengths
-  std::vector<Vec2> positions_;        // m, its nodes
   std::vector<double> across_;         // Pa, the whole crack's pressures after the last step
   std::size_t inlet_ = 0;
   bool flow_rate_ = false;
