@@ -310,32 +310,59 @@ class Solver:
         c[t] = amp * st ** (a + 1) / (a + 1)
         return o, c
 
-    def residual(self, y):
+    # --- lubrication, F / Omega^3 weighted by the hats, with F = a1 xi Omega + a2 C + G
+    #     (self-similar: a1 = 2/3 gamma^2, a2 = gamma^2, G = 0; tools/kgd_notch.py: a time step)
+    def lub_points(self, o, c, a1, a2, G=0.0):
+        """The integrand, times the weights, at the lubrication points."""
+        return self.q_w * (a1 * self.q_xi / o ** 2 + (a2 * c + G) / o ** 3)
+
+    def lub(self, f):
+        """Per equation j (0..N-2): the rise in cell j and the fall in cell j+1."""
         np, N = self.np, self.N
+        out = np.zeros(N + 1)
+        np.add.at(out, self.q_cell, f * self.q_rise)
+        np.add.at(out, self.q_cell - 1, f * (1 - self.q_rise))
+        return out[:N - 1]
+
+    def pressure(self, om, amp, g):
+        """Cell averages of Pi at the nodes."""
+        return (self.A @ om + self.T * amp) / (4 * math.pi * g)
+
+    def residual(self, y):
+        N = self.N
         om, g, amp = self.unpack(y)
         cn = self.cumulative(om, amp)
-        p = (self.A @ om + self.T * amp) / (4 * math.pi * g)
+        p = self.pressure(om, amp, g)
         o, c = self.at_points(om, amp, cn)
-        f = self.q_w * ((2 / 3) * self.q_xi / o ** 2 + c / o ** 3)
-        lub = np.zeros(N + 1)  # equation j (0..N-2) gets rise in cell j and fall in cell j+1
-        np.add.at(lub, self.q_cell, f * self.q_rise)
-        np.add.at(lub, self.q_cell - 1, f * (1 - self.q_rise))
-        r = np.empty(N)
-        r[:N - 1] = p[:N - 1] - p[1:] - g * g * lub[:N - 1]
+        r = self.np.empty(N)
+        r[:N - 1] = p[:N - 1] - p[1:] - self.lub(self.lub_points(o, c, (2 / 3) * g * g, g * g))
         r[N - 1] = g * cn[0] - 0.5
         return r
 
     def jacobian(self, y):
-        np, N, h = self.np, self.N, self.h
+        np, N = self.np, self.N
         om, g, amp = self.unpack(y)
         cn = self.cumulative(om, amp)
         o, c = self.at_points(om, amp, cn)
         J = np.zeros((N, N))
         A = self.A[:, :N - 1] / (4 * math.pi * g)
-        J[:N - 1, :N - 1] = A[:N - 1] - A[1:]
+        J[:N - 1, :N - 1] = A[:N - 1] - A[1:] - self.lub_jacobian(o, c, (2 / 3) * g * g, g * g)
+        J[N - 1, 0] = g * 0.5 * self.h[0]
+        J[N - 1, 1:N - 1] = g * self.wk[1:]
+        J[:, :N - 1] *= om[None, :N - 1]  # unknowns are ln Omega
+        eps = 1e-6  # ln gamma column: central difference
+        yp, ym = y.copy(), y.copy()
+        yp[N - 1] += eps
+        ym[N - 1] -= eps
+        J[:, N - 1] = (self.residual(yp) - self.residual(ym)) / (2 * eps)
+        return J
+
+    def lub_jacobian(self, o, c, a1, a2, G=0.0):
+        """d lub(lub_points(...)) / d Omega_k, k = 0..N-2 (the tip element's points held)."""
+        np, N, h = self.np, self.N, self.h
         lam, e, xi, w = self.q_lam, self.q_elem, self.q_xi, self.q_w
-        dgdo = w * (-(4 / 3) * xi / o ** 3 - 3 * c / o ** 4)
-        dgdc = w / o ** 3
+        dgdo = w * (-2 * a1 * xi / o ** 3 - 3 * (a2 * c + G) / o ** 4)
+        dgdc = w * a2 / o ** 3
         lin = ~self.q_tip  # the tip element's points depend on gamma only
         d_left = np.where(lin, dgdo * (1 - lam) + dgdc * h[e] * (1 - lam) ** 2 / 2, 0.0)
         d_right = np.where(lin & (e + 1 <= N - 2), dgdo * lam + dgdc * h[e] * (1 - lam ** 2) / 2, 0.0)
@@ -350,17 +377,7 @@ class Solver:
         Bc = Bc[1:N, :N - 1]  # equations 0..N-2, C at nodes 0..N-2 (C at N-1 and N: gamma only)
         # sum_n Bc[j, n] dC_n/dOmega_k = wk_k sum_{n<k} Bc[j, n] + Bc[j, k] h_k / 2
         prior = np.cumsum(Bc, axis=1) - Bc
-        dlub = B[1:N, :N - 1] + prior * self.wk[None, :] + Bc * (0.5 * h[None, :N - 1])
-        J[:N - 1, :N - 1] -= g * g * dlub
-        J[N - 1, 0] = g * 0.5 * h[0]
-        J[N - 1, 1:N - 1] = g * self.wk[1:]
-        J[:, :N - 1] *= om[None, :N - 1]  # unknowns are ln Omega
-        eps = 1e-6  # ln gamma column: central difference
-        yp, ym = y.copy(), y.copy()
-        yp[N - 1] += eps
-        ym[N - 1] -= eps
-        J[:, N - 1] = (self.residual(yp) - self.residual(ym)) / (2 * eps)
-        return J
+        return B[1:N, :N - 1] + prior * self.wk[None, :] + Bc * (0.5 * h[None, :N - 1])
 
     def guess(self, start=None):
         """ln Omega, ln gamma: from a previous solution (start = (s, Omega, gamma), s decreasing) or the vertices."""
@@ -413,22 +430,21 @@ class Solver:
 
     def results(self):
         """gamma, Omega(0), Pi(0) (Pi(0) = the centre cell's average + gamma^2 int_0^{m_0} (1 - xi/m_0) F/Omega^3)."""
-        np = self.np
         om, g, amp = self.unpack(self.y)
         cn = self.cumulative(om, amp)
         o, c = self.at_points(om, amp, cn)
-        p = (self.A @ om + self.T * amp) / (4 * math.pi * g)
+        return g, om[0], self.inlet_pressure(self.pressure(om, amp, g), self.lub_points(o, c, (2 / 3) * g * g, g * g))
+
+    def inlet_pressure(self, p, f):
+        """Pi(0): the centre cell's average plus the lubrication's drop from xi = 0 to the cell's mean."""
         sel = self.q_cell == 0
-        f = self.q_w[sel] * ((2 / 3) * self.q_xi[sel] / o[sel] ** 2 + c[sel] / o[sel] ** 3)
-        p0 = p[0] + g * g * np.sum(f * (1 - self.q_rise[sel]))
-        return g, om[0], p0
+        return p[0] + self.np.sum(f[sel] * (1 - self.q_rise[sel]))
 
     def profile(self):
         """xi and Omega at the nodes (with the tip), Pi as cell averages at the nodes."""
         np = self.np
         om, g, amp = self.unpack(self.y)
-        p = (self.A @ om + self.T * amp) / (4 * math.pi * g)
-        return 1 - self.s, np.concatenate([om, [0.0]]), p
+        return 1 - self.s, np.concatenate([om, [0.0]]), self.pressure(om, amp, g)
 
 
 def solve(km, rho=16.0, s_tip=None, start=None):
