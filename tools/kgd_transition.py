@@ -328,6 +328,14 @@ class Solver:
         """Cell averages of Pi at the nodes."""
         return (self.A @ om + self.T * amp) / (4 * math.pi * g)
 
+    def lub_coefficients(self, g):
+        """(a1, a2, G) of lub_points: the self-similar problem's (tools/kgd_notch.py: a time step's)."""
+        return (2 / 3) * g * g, g * g, 0.0
+
+    def volume_target(self, g):
+        """gamma C(0) equals this; its row is divided by it (tools/kgd_notch.py: the injected volume)."""
+        return 0.5
+
     def residual(self, y):
         N = self.N
         om, g, amp = self.unpack(y)
@@ -335,8 +343,9 @@ class Solver:
         p = self.pressure(om, amp, g)
         o, c = self.at_points(om, amp, cn)
         r = self.np.empty(N)
-        r[:N - 1] = p[:N - 1] - p[1:] - self.lub(self.lub_points(o, c, (2 / 3) * g * g, g * g))
-        r[N - 1] = g * cn[0] - 0.5
+        r[:N - 1] = p[:N - 1] - p[1:] - self.lub(self.lub_points(o, c, *self.lub_coefficients(g)))
+        v = self.volume_target(g)
+        r[N - 1] = (g * cn[0] - v) / v
         return r
 
     def jacobian(self, y):
@@ -346,11 +355,12 @@ class Solver:
         o, c = self.at_points(om, amp, cn)
         J = np.zeros((N, N))
         A = self.A[:, :N - 1] / (4 * math.pi * g)
-        J[:N - 1, :N - 1] = A[:N - 1] - A[1:] - self.lub_jacobian(o, c, (2 / 3) * g * g, g * g)
-        J[N - 1, 0] = g * 0.5 * self.h[0]
-        J[N - 1, 1:N - 1] = g * self.wk[1:]
+        J[:N - 1, :N - 1] = A[:N - 1] - A[1:] - self.lub_jacobian(o, c, *self.lub_coefficients(g))
+        v = self.volume_target(g)
+        J[N - 1, 0] = g * 0.5 * self.h[0] / v
+        J[N - 1, 1:N - 1] = g * self.wk[1:] / v
         J[:, :N - 1] *= om[None, :N - 1]  # unknowns are ln Omega
-        eps = 1e-6  # ln gamma column: central difference
+        eps = 1e-6  # the last column (ln gamma; kgd_notch: ln gamma'): central difference
         yp, ym = y.copy(), y.copy()
         yp[N - 1] += eps
         ym[N - 1] -= eps
@@ -401,9 +411,10 @@ class Solver:
         om, g, amp = self.unpack(self.y)
         return self.s[:self.N], om, g
 
-    def solve(self, start=None, maxit=60):
+    def newton(self, y, maxit, t_min=1e-3, tol=1e-12):
+        """Newton on residual() from y with a backtracking line search: (y, iterations, |r|), or
+        RuntimeError when maxit iterations leave a step above tol."""
         np = self.np
-        y = self.guess(start)
         r = self.residual(y)
         nr = np.linalg.norm(r)
         for it in range(maxit):
@@ -414,18 +425,23 @@ class Solver:
                 with np.errstate(all="ignore"):
                     rn = self.residual(yn)
                 nrn = np.linalg.norm(rn)
-                if (np.isfinite(nrn) and nrn < (1 - 1e-4 * t) * nr) or t < 1e-3:
+                if (np.isfinite(nrn) and nrn < (1 - 1e-4 * t) * nr) or t < t_min:
                     break
                 t *= 0.5
             y, r, nr = yn, rn, nrn
-            if np.max(np.abs(t * dy)) < 1e-12:
-                break
-        else:
-            raise RuntimeError(f"kgd_transition: Newton did not converge at Km = {self.km} (|r| = {nr:.3g})")
-        if not np.isfinite(nr):
+            if np.max(np.abs(t * dy)) < tol:
+                return y, it + 1, nr
+        raise RuntimeError(f"Newton did not converge in {maxit} iterations (|r| = {nr:.3g})")
+
+    def solve(self, start=None, maxit=60):
+        try:
+            y, its, nr = self.newton(self.guess(start), maxit)
+        except RuntimeError as e:
+            raise RuntimeError(f"kgd_transition: at Km = {self.km}: {e}") from None
+        if not self.np.isfinite(nr):
             raise RuntimeError(f"kgd_transition: no solution at Km = {self.km}")
         self.y = y
-        self.iterations = it + 1
+        self.iterations = its
         return self.results()
 
     def results(self):
@@ -433,7 +449,7 @@ class Solver:
         om, g, amp = self.unpack(self.y)
         cn = self.cumulative(om, amp)
         o, c = self.at_points(om, amp, cn)
-        return g, om[0], self.inlet_pressure(self.pressure(om, amp, g), self.lub_points(o, c, (2 / 3) * g * g, g * g))
+        return g, om[0], self.inlet_pressure(self.pressure(om, amp, g), self.lub_points(o, c, *self.lub_coefficients(g)))
 
     def inlet_pressure(self, p, f):
         """Pi(0): the centre cell's average plus the lubrication's drop from xi = 0 to the cell's mean."""
