@@ -329,13 +329,15 @@ TEST(KgdScene, ToughnessCiSceneWithASoftFluidFollowsTheKVertex) {
 // mu = 1e-4 Pa s, 1e-5 m^2/s into the wing ramped over 5 s, h = 2 m, 300 s,
 // the implicit scheme at the solid's step). From three notch lengths on (the
 // 4 m notch), the mouth opening within the CI 10% of the M-vertex and the net
-// inlet pressure within 20% (measured 3.5% and 9.3% with the tip-asymptote
-// closure and quarter-cell growth; 3.2% and 7.2% with the vacuum front and
-// half-cell growth); the fluid front within 20% at every row and within 10%
-// at the end (measured 4.3% worst, 2.5% at the end; before 15.5% and 5.8%),
-// where the tip may lead it by the zero-lag closure's wait and a growth step
-// (the tip is printed, not asserted: 17% at the first row, 8.5% at 300 s;
-// before 29% and 11%). The water's volume (sum of l w) is
+// inlet pressure within 20% (measured 5.4% and 12.4% with the matched closure
+// and the faces read from the material, since 5 December; 3.5% and 9.3% with
+// the tip-asymptote closure and velocity-read faces; 3.2% and 7.2% with the
+// vacuum front and half-cell growth); the fluid front within 20% at every row
+// and within 10% at the end (measured 4.4% worst, -4.4% at the end; before
+// 4.3% and 2.5%, and 15.5% and 5.8%), where the tip may lead it by the
+// zero-lag closure's wait and a growth step (the tip is printed, not
+// asserted: 11% worst, 3.5% at 300 s; before 17% and 8.5%, 29% and 11%).
+// The water's volume (sum of l w) is
 // the injected volume plus the notch's virtual film within 1%: its
 // compression p / K ~ 5e-4, and a partly filled front particle counts the
 // empty part of its domain (measured 0.99947 to 1.0082, the
@@ -357,10 +359,12 @@ TEST(KgdScene, FieldScaleWaterCiSceneFollowsTheMVertex) {
     if (t[i] > 10) {
       // From 20 s within 1%; at 10 s the front particle, at zero pressure,
       // is stretched past its rest volume (water cavitates rather than carry
-      // tension) and its domain counts some empty crack: measured 1.0462
-      // with the tip-asymptote closure, 0.9995 from 20 s on.
+      // tension) and its domain counts some empty crack: measured 1.0630
+      // with the matched closure (4.7e-6 m^2, a twentieth of the front
+      // cell's volume), 1.0462 with the tip-asymptote closure, 0.9995 from
+      // 20 s on.
       const double ratio = volume[i] / (injected[i] + kFilm);
-      EXPECT_NEAR(ratio, 1.0, t[i] < 20 ? 5e-2 : 1e-2) << "t = " << t[i];
+      EXPECT_NEAR(ratio, 1.0, t[i] < 20 ? 1e-1 : 1e-2) << "t = " << t[i];
     }
     if (front[i] < 3 * kNotch) continue;
     const Vertex v = m_vertex(2e10, 0.25, 1e-4, kQ, t[i] - 0.5 * kRamp);
