@@ -46,7 +46,10 @@ struct Derived {
   double density_scaling = 1;
   double virtual_opening = 0;  // m
   double damping = 0;          // 1/s, the grid's mass-proportional damping
-  int cells_x = 0;             // cells from the crack to the body's edge, along it and across it
+  // Cells the tip grows by at a step and waits for the fluid within: 1/4,
+  // or 1/8 or 1/16 for a viscosity-dominated crack on a coarse notch.
+  double growth_cells = 0.25;
+  int cells_x = 0;  // cells from the crack to the body's edge, along it and across it
   // Where the robustness matrix (docs/verification.md, "Scenes from physics
   // alone") saw runs like this one stall or stop: one line each, also in the
   // scene's comments. Empty: inside what the matrix ran to completion.

@@ -329,14 +329,14 @@ TEST(KgdScene, ToughnessCiSceneWithASoftFluidFollowsTheKVertex) {
 // mu = 1e-4 Pa s, 1e-5 m^2/s into the wing ramped over 5 s, h = 2 m, 300 s,
 // the implicit scheme at the solid's step). From three notch lengths on (the
 // 4 m notch), the mouth opening within the CI 10% of the M-vertex and the net
-// inlet pressure within 20% (measured 5.4% and 12.4% with the matched closure
-// and the faces read from the material, since 5 December; 3.5% and 9.3% with
-// the tip-asymptote closure and velocity-read faces; 3.2% and 7.2% with the
-// vacuum front and half-cell growth); the fluid front within 20% at every row
-// and within 10% at the end (measured 4.4% worst, -4.4% at the end; before
-// 4.3% and 2.5%, and 15.5% and 5.8%), where the tip may lead it by the
-// zero-lag closure's wait and a growth step (the tip is printed, not
-// asserted: 11% worst, 3.5% at 300 s; before 17% and 8.5%, 29% and 11%).
+// inlet pressure within 20% (measured 3.7% and 10.2% with the matched closure,
+// the faces read from the material and growth by 1/16 cell, since 5 December;
+// 5.4% and 12.4% at a quarter cell; 3.5% and 9.3% with the tip-asymptote
+// closure and velocity-read faces; 3.2% and 7.2% with the vacuum front and
+// half-cell growth); the fluid front within 20% at every row and within 10% at
+// the end (measured 5.6% worst; before 4.4%, 4.3%, and 15.5%), where the tip
+// may lead it by the zero-lag closure's wait and a growth step (the tip is
+// printed, not asserted: 4.6% worst; before 11%, 17%, 29%).
 // The water's volume (sum of l w) is
 // the injected volume plus the notch's virtual film within 1%: its
 // compression p / K ~ 5e-4, and a partly filled front particle counts the

@@ -115,7 +115,15 @@ TEST(SceneBuilder, ViscosityDominatedSceneFollowsItsDerivation) {
   EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE_MATCHED);
   EXPECT_TRUE(mpm.fracture().surfaces_from_material());  // the matched closure needs the true widths
   EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e6);
-  EXPECT_DOUBLE_EQ(mpm.fracture().max_lag_cells(), 0.25);
+  // Growth and wait: the tip leads the front by up to 2 g h, within 2.5% of
+  // three notch lengths, g the largest of 1/4, 1/8, 1/16 that keeps it: the
+  // 2 m notch on 0.99 m cells takes 1/16 (2 g h = 0.12 m against 0.15 m; 1/8
+  // would lead by 0.25 m).
+  EXPECT_DOUBLE_EQ(mpm.fracture().max_lag_cells(), 0.0625);
+  EXPECT_DOUBLE_EQ(mpm.fracture().growth_cells(), 0.0625);
+  EXPECT_DOUBLE_EQ(built.derived.growth_cells, 0.0625);
+  EXPECT_LE(2 * 0.0625 * h, 0.025 * 3 * 2.0);
+  EXPECT_GT(2 * 0.125 * h, 0.025 * 3 * 2.0);
   EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
   EXPECT_DOUBLE_EQ(s.fluid().mpm().bulk_modulus_pa(), 2e9);  // water by default
   // One wing: half the total rate, ramped.
