@@ -100,6 +100,12 @@ class Notched(kgd_transition.Solver):
     def volume_target(self, g):
         return max(self.volume(g), 1e-300)
 
+    def mean_pressure(self, y):
+        """Pi averaged over the crack, weighted by the opening (cell averages at the nodes)."""
+        om, g, amp = self.unpack(y)
+        wt = om * (self.cell_hi - self.cell_lo)
+        return float((self.pressure(om, amp, g) * wt).sum() / wt.sum())
+
     def observe(self, y):
         """gamma, Omega(0), Pi(0) and C at the lubrication points of the solved step."""
         om, g, amp = self.unpack(y)
@@ -113,12 +119,20 @@ def gamma_v_of():
     return kgd_transition.constants(0.0)[0]
 
 
+def tait_volume_ratio(p, K, c):
+    """J = V / V0 of hfmpm's Tait fluid at pressure p (fluid/include/hfmpm/fluid/mpm/eos.hpp)."""
+    return 1 - c * math.log1p(p / (c * K))
+
+
 def solve(E, nu, mu, Q, notch, times, ramp=0.0, film=0.0, rho=4.0, per_doubling=STEPS_PER_DOUBLING,
-          start_fraction=START_FRACTION):
+          start_fraction=START_FRACTION, fluid=None):
     """[(t, half-length, mouth opening, net inlet pressure, Newton iterations)] at each of times.
 
     Q: the TOTAL rate (both wings) at the end of a linear ramp over [0, ramp] (ramp = 0: constant);
-    notch: the initial half-length l0; film: the virtual film w_v (0: none)."""
+    notch: the initial half-length l0; film: the virtual film w_v (0: none); fluid: None (the
+    vertices' incompressible fluid) or (K, tait_c, sigma0): the injected mass (rho0 Q t) fills
+    J(sigma0 + p) of its volume, p the crack's mean net pressure (opening-weighted, from the step
+    before: it changes by under 1e-3 of itself per step)."""
     times = sorted(float(t) for t in times)
     if not times or times[0] <= 0 or notch <= 0 or Q <= 0 or E <= 0 or mu <= 0 or not -1 < nu < 0.5:
         raise ValueError("kgd_notch: need times > 0, notch > 0, Q > 0, E > 0, mu > 0 and -1 < nu < 0.5")
@@ -150,13 +164,14 @@ def solve(E, nu, mu, Q, notch, times, ramp=0.0, film=0.0, rho=4.0, per_doubling=
     vertex = kgd_transition.Solver(0.0, rho)
     vertex.solve()
     om_v, g_v, amp_v = vertex.unpack(vertex.y)  # gamma_v C_v(0) = 1/2
-    scale = (injected(t) / vscale) / (g0 * vertex.cumulative(om_v, amp_v)[0])
+    ratio0 = 1.0 if fluid is None else tait_volume_ratio(fluid[2], fluid[0], fluid[1])  # compressed at sigma0
+    scale = (injected(t) * ratio0 / vscale) / (g0 * vertex.cumulative(om_v, amp_v)[0])
     om0, amp0 = scale * om_v, scale * amp_v
     c_prev = sv.at_points(om0, amp0, sv.cumulative(om0, amp0))[1]
     gam, gam_prev, c_old, dt_prev = g0, g0, None, 0.0
     y = np.concatenate([np.log(om0[:N - 1]), [3 * math.log(amp0 / (BETA_M * g0 ** (2 / 3)))]])  # its speed from its tip
     grow = 2 ** (1 / per_doubling)
-    out, k, cut, rejected = [], 0, 1.0, 0
+    out, k, cut, rejected, p_mean = [], 0, 1.0, 0, 0.0
     while k < len(times):
         # steps of t (grow - 1), from 1e-4 of that at the start, cut after a rejected step
         dt = cut * min(t * (grow - 1), 2 * dt_prev if dt_prev > 0 else 1e-4 * t)
@@ -165,8 +180,10 @@ def solve(E, nu, mu, Q, notch, times, ramp=0.0, film=0.0, rho=4.0, per_doubling=
         t_new = t + dt
         omega = dt / dt_prev if dt_prev > 0 else 0.0
 
-        def volume(g, t_new=t_new):
-            return max(injected(t_new) - film * (g - g0) * Lr, 1e-30 * vscale) / vscale
+        ratio = 1.0 if fluid is None else tait_volume_ratio(fluid[2] + p_mean, fluid[0], fluid[1])
+
+        def volume(g, t_new=t_new, ratio=ratio):
+            return max(injected(t_new) * ratio - film * (g - g0) * Lr, 1e-30 * vscale) / vscale
 
         sv.set_step(dt / tr, gam, gam_prev, c_prev, c_old, omega, volume)
         try:
@@ -181,6 +198,8 @@ def solve(E, nu, mu, Q, notch, times, ramp=0.0, film=0.0, rho=4.0, per_doubling=
         cut = min(1.0, 2 * cut)
         y = y_new
         g, om_c, pi_c, c_new = sv.observe(y)
+        if fluid is not None:
+            p_mean = sv.mean_pressure(y) * er * ep
         gam_prev, gam, c_old, c_prev, dt_prev, t = gam, g, c_prev, c_new, dt, t_new
         if abs(t - times[k]) <= 1e-9 * times[k]:
             out.append((t, g * Lr, om_c * er * Lr, pi_c * er * ep, its))
@@ -211,11 +230,12 @@ def run_setup(run):
             sys.exit("kgd_notch: only a ramp from zero at t = 0 is modelled")
         ramp = float(r["t1"])
     prm.update(notch=0.5 * length if prm.get("two_wing") else length, ramp=ramp,
-               film=float(fluid.get("virtual_opening_m", 0.0)))
+               film=float(fluid.get("virtual_opening_m", 0.0)), bulk_modulus=float(fluid.get("bulk_modulus_pa", 0)),
+               tait_c=float(fluid.get("tait_c", 0.0894)))
     return prm
 
 
-def compare(run, rho, film_on):
+def compare(run, rho, film_on, compressible=False):
     import kgd_plot
     prm = run_setup(run)
     h = kgd_plot.read_history(os.path.join(run, "history.csv"))
@@ -231,10 +251,17 @@ def compare(run, rho, film_on):
         sys.exit(f"kgd_notch: {run}: the crack never reaches three notch lengths ({3 * prm['notch']:g} m)")
     times = [h["time_s"][i] for i in rows]
     film = prm["film"] if film_on else 0.0
-    ref = solve(prm["E"], prm["nu"], prm["mu"], prm["Q"], prm["notch"], times, prm["ramp"], film, rho)
+    fluid = None
+    if compressible:
+        if not prm["bulk_modulus"] > 0:
+            sys.exit(f"kgd_notch: {run}: the scene's fluid has no bulk modulus; --compressible needs one")
+        fluid = (prm["bulk_modulus"], prm["tait_c"], prm["sigma0"])
+    ref = solve(prm["E"], prm["nu"], prm["mu"], prm["Q"], prm["notch"], times, prm["ramp"], film, rho, fluid=fluid)
     t0 = 0.5 * prm["ramp"]
     print(f"{run}: E {prm['E']:g} Pa, nu {prm['nu']:g}, mu {prm['mu']:g} Pa s, Q {prm['Q']:g} m^2/s (total), "
-          f"ramp {prm['ramp']:g} s, notch {prm['notch']:g} m, film {film:g} m; rows from three notch lengths on")
+          f"ramp {prm['ramp']:g} s, notch {prm['notch']:g} m, film {film:g} m"
+          + (f", fluid K {prm['bulk_modulus']:g} Pa at sigma0 {prm['sigma0']:g} Pa" if fluid else "")
+          + "; rows from three notch lengths on")
     print(f"{'t (s)':>8} {'l ref':>8} {'tip':>7} {'front':>7} {'w0':>7} {'p0':>7} | {'Km: tip':>7} {'front':>7} "
           f"{'w0':>7} {'p0':>7}")
     worst = [0.0] * 8
@@ -297,6 +324,17 @@ def self_test():
     phi = wv * (lf - 2.0) / (0.5 * Q * (100.0 - 2.5))
     check(abs((lf - l0) / l0 + phi / 2) < 0.15 * phi / 2,
           f"a film of {wv:g} m shortens the crack by {100 * (l0 - lf) / l0:.2f}%, phi / 2 = {50 * phi:.2f}%")
+    # 5. a compressible fluid: the injected mass fills J of its volume, and at fixed time the
+    #    vertex's length and opening go as V^(1/2): both shorter by about (1 - J) / 2
+    E, nu, mu, Q, K, c, s0 = 1e7, 0.25, 0.01, 2.5e-4, 2e6, 0.0894, 1e5
+    inc = solve(E, nu, mu, Q, 0.15, [5.0], ramp=0.05)[0]
+    com = solve(E, nu, mu, Q, 0.15, [5.0], ramp=0.05, fluid=(K, c, s0))[0]
+    j = tait_volume_ratio(s0 + com[3], K, c)  # about: the mean net pressure is below the inlet's
+    dl, dw = com[1] / inc[1] - 1, com[2] / inc[2] - 1
+    want = math.sqrt(j) - 1
+    check(abs(dl - want) < 0.25 * abs(want) and abs(dw - want) < 0.25 * abs(want),
+          f"kgd-viscosity-ci's set-up with K = 2 MPa: length {100 * dl:+.2f}%, opening {100 * dw:+.2f}% against the "
+          f"incompressible fluid; J^(1/2) - 1 = {100 * (math.sqrt(j) - 1):+.2f}% at sigma0 + the inlet pressure")
     return fails
 
 
@@ -333,6 +371,9 @@ def main():
     ap.add_argument("--ramp", type=float, default=0.0, help="a linear ramp from 0 over [0, RAMP] s (default 0)")
     ap.add_argument("--film", type=float, default=0.0, help="the virtual film (m; a run's own by default)")
     ap.add_argument("--no-film", action="store_true", help="with a run: leave the scene's film out")
+    ap.add_argument("--compressible", action="store_true",
+                    help="with a run: its fluid's Tait compression at sigma0 + the mean net pressure (the vertices' "
+                         "fluid is incompressible)")
     ap.add_argument("--times", help="comma-separated times (s) for the reference alone")
     ap.add_argument("--rho", type=float, default=4.0, help="space resolution (kgd_transition's rho; default 4)")
     ap.add_argument("--convergence", action="store_true")
@@ -344,7 +385,7 @@ def main():
         convergence()
         return
     if a.run:
-        compare(a.run, a.rho, not a.no_film)
+        compare(a.run, a.rho, not a.no_film, a.compressible)
         return
     need = [k for k in ("E", "nu", "mu", "Q", "notch", "times") if getattr(a, k) is None]
     if need:
