@@ -367,9 +367,10 @@ BuiltScene build_scene(const problem::Problem& p) {
                   std::string(settle > 0 ? ", and lets the opening follow (2 transits)" : "") +
                   (d.viscosity_dominated ? "" : " (Km < 2: the closure of the nearer vertex)") + ".\n"
             : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
-              "#   the tip waits for the fluid within 0.25 cell, grows by 0.25 cell and lets the "
-              "opening follow (2 transits);\n"
-              "#   the faces' opening is read from the material.\n")
+              "#   the tip waits for the fluid within " +
+                  approx(growth) + " cell, grows by " + approx(growth) +
+                  " cell and lets the opening follow (2 transits);\n"
+                  "#   the faces' opening is read from the material.\n")
     << "#   damping " << approx(d.damping) << " /s: critical for the body's lowest mode (" << approx(omega) << " rad/s)"
     << (settle > 0 ? " or, with toughness, for the crack's own quarter-wave mode at three notch lengths" : "")
     << " or less, so that the body lags a rising load by at most 2% of the time the crack\n"

@@ -2,6 +2,7 @@
 """The KGD hydraulic fracture from a finite notch, under a time-varying rate: a time-dependent reference.
 
     /usr/bin/python3 tools/kgd_notch.py RUN_DIR                 # a run against the notched reference
+    /usr/bin/python3 tools/kgd_notch.py RUN --against BASE --compressible   # two runs, each against its own
     /usr/bin/python3 tools/kgd_notch.py --E 2e10 --nu 0.25 --mu 1e-4 --Q 2e-5 --notch 2 \
         --ramp 5 --times 50,100,300                             # the reference alone
     /usr/bin/python3 tools/kgd_notch.py --convergence           # refinement in space and time
@@ -115,10 +116,6 @@ class Notched(kgd_transition.Solver):
         return g, om[0], self.inlet_pressure(p, self.lub_points(o, c, *self.lub_coefficients(g))), c
 
 
-def gamma_v_of():
-    return kgd_transition.constants(0.0)[0]
-
-
 def tait_volume_ratio(p, K, c):
     """J = V / V0 of hfmpm's Tait fluid at pressure p (fluid/include/hfmpm/fluid/mpm/eos.hpp)."""
     return 1 - c * math.log1p(p / (c * K))
@@ -152,11 +149,11 @@ def solve(E, nu, mu, Q, notch, times, ramp=0.0, film=0.0, rho=4.0, per_doubling=
     # start: the notch holding what has been injected by then, in the M-vertex's shape (an exact
     # state of a propagating crack: the vertex of a smaller rate at the moment it is l0 long)
     # from the time the vertex holding the injected volume would be start_fraction l0 long
-    lo_t, hi_t = 1e-12 * times[0], times[0]
+    lo_t, hi_t, gamma_v = 1e-12 * times[0], times[0], kgd_transition.constants(0.0)[0]
     for _ in range(200):
         t = math.sqrt(lo_t * hi_t)
         t_eff = 2 * injected(t) / Q
-        if gamma_v_of() * (ep * Q ** 3 * t_eff ** 4 / mup) ** (1 / 6) > start_fraction * notch:
+        if gamma_v * (ep * Q ** 3 * t_eff ** 4 / mup) ** (1 / 6) > start_fraction * notch:
             hi_t = t
         else:
             lo_t = t
@@ -235,7 +232,10 @@ def run_setup(run):
     return prm
 
 
-def compare(run, rho, film_on, compressible=False):
+def evaluate(run, rho, film_on, compressible=False):
+    """A run's rows from three notch lengths on and the notched reference at them: (prm, fluid, rows), each row
+    (t, (tip, front, mouth opening, net inlet pressure), (length, mouth opening, net inlet pressure) of the
+    reference)."""
     import kgd_plot
     prm = run_setup(run)
     h = kgd_plot.read_history(os.path.join(run, "history.csv"))
@@ -249,26 +249,35 @@ def compare(run, rho, film_on, compressible=False):
     rows = [i for i, t in enumerate(h["time_s"]) if t > 0 and tip[i] >= 3 * prm["notch"]]
     if not rows:
         sys.exit(f"kgd_notch: {run}: the crack never reaches three notch lengths ({3 * prm['notch']:g} m)")
-    times = [h["time_s"][i] for i in rows]
-    film = prm["film"] if film_on else 0.0
     fluid = None
     if compressible:
         if not prm["bulk_modulus"] > 0:
             sys.exit(f"kgd_notch: {run}: the scene's fluid has no bulk modulus; --compressible needs one")
         fluid = (prm["bulk_modulus"], prm["tait_c"], prm["sigma0"])
-    ref = solve(prm["E"], prm["nu"], prm["mu"], prm["Q"], prm["notch"], times, prm["ramp"], film, rho, fluid=fluid)
+    prm["film_used"] = prm["film"] if film_on else 0.0
+    times = [h["time_s"][i] for i in rows]
+    ref = solve(prm["E"], prm["nu"], prm["mu"], prm["Q"], prm["notch"], times, prm["ramp"], prm["film_used"], rho,
+                fluid=fluid)
+    out = []
+    for i, (tt, lr, wr, pr, _) in zip(rows, ref):
+        sim = (tip[i], front[i] if front else float("nan"), h["mouth_opening_m"][i],
+               h["inlet_pressure_pa"][i] - prm["sigma0"])
+        out.append((tt, sim, (lr, wr, pr)))
+    return prm, fluid, out
+
+
+def compare(run, rho, film_on, compressible=False):
+    prm, fluid, rows = evaluate(run, rho, film_on, compressible)
     t0 = 0.5 * prm["ramp"]
     print(f"{run}: E {prm['E']:g} Pa, nu {prm['nu']:g}, mu {prm['mu']:g} Pa s, Q {prm['Q']:g} m^2/s (total), "
-          f"ramp {prm['ramp']:g} s, notch {prm['notch']:g} m, film {film:g} m"
+          f"ramp {prm['ramp']:g} s, notch {prm['notch']:g} m, film {prm['film_used']:g} m"
           + (f", fluid K {prm['bulk_modulus']:g} Pa at sigma0 {prm['sigma0']:g} Pa" if fluid else "")
           + "; rows from three notch lengths on")
     print(f"{'t (s)':>8} {'l ref':>8} {'tip':>7} {'front':>7} {'w0':>7} {'p0':>7} | {'Km: tip':>7} {'front':>7} "
           f"{'w0':>7} {'p0':>7}")
     worst = [0.0] * 8
-    for i, (tt, lr, wr, pr, _) in zip(rows, ref):
+    for tt, sim, (lr, wr, pr) in rows:
         m = kgd_transition.transition(prm["E"], prm["nu"], prm["mu"], prm["Q"], prm["KIc"], tt - t0)
-        sim = (tip[i], front[i] if front else float("nan"), h["mouth_opening_m"][i],
-               h["inlet_pressure_pa"][i] - prm["sigma0"])
         e = [(sim[0] - lr) / lr, (sim[1] - lr) / lr, (sim[2] - wr) / wr, (sim[3] - pr) / pr,
              (sim[0] - m[0]) / m[0], (sim[1] - m[0]) / m[0], (sim[2] - m[1]) / m[1], (sim[3] - m[2]) / m[2]]
         worst = [max(a, abs(b)) if b == b else a for a, b in zip(worst, e)]
@@ -278,6 +287,30 @@ def compare(run, rho, film_on, compressible=False):
           f"pressure {worst[3]:.3f}; against the solution at the run's Km (t - {t0:g} s, tools/kgd_transition.py): "
           f"tip {worst[4]:.3f}, front {worst[5]:.3f}, opening {worst[6]:.3f}, pressure {worst[7]:.3f}")
     return worst
+
+
+def against(run, base, rho, film_on, compressible):
+    """Two runs of one set-up (another fluid stiffness, step, ...), row by row at the times both have: how far
+    apart the runs are, how far apart their references are, and how far apart their errors against their own
+    references are (front, mouth opening, net inlet pressure; the worst over the common rows)."""
+    _, _, a = evaluate(run, rho, film_on, compressible)
+    _, _, b = evaluate(base, rho, film_on, compressible)
+    by_time = {round(t, 6): (sim, ref) for t, sim, ref in b}
+    common = [(sim, ref, by_time[round(t, 6)]) for t, sim, ref in a if round(t, 6) in by_time]
+    if not common:
+        sys.exit(f"kgd_notch: {run} and {base} have no output time in common from three notch lengths on")
+    runs, refs, errors = [0.0] * 3, [0.0] * 3, [0.0] * 3
+    for sim, ref, (sim_b, ref_b) in common:
+        for k, j in enumerate((1, 2, 3)):  # front, opening, pressure; the reference's length is its front
+            r = 0 if j == 1 else j - 1
+            runs[k] = max(runs[k], abs(sim[j] / sim_b[j] - 1))
+            refs[k] = max(refs[k], abs(ref[r] / ref_b[r] - 1))
+            errors[k] = max(errors[k], abs((sim[j] / ref[r]) / (sim_b[j] / ref_b[r]) - 1))
+    print(f"{run} against {base}, {len(common)} rows from three notch lengths on (front / opening / pressure), "
+          f"{'compressible' if compressible else 'incompressible'} references:")
+    print("  the runs differ by              " + " / ".join(f"{100 * v:.1f}%" for v in runs))
+    print("  their references differ by      " + " / ".join(f"{100 * v:.1f}%" for v in refs))
+    print("  their errors against their own  " + " / ".join(f"{100 * v:.1f}%" for v in errors))
 
 
 # ----------------------------------------------------------------------------- checks
@@ -371,6 +404,9 @@ def main():
     ap.add_argument("--ramp", type=float, default=0.0, help="a linear ramp from 0 over [0, RAMP] s (default 0)")
     ap.add_argument("--film", type=float, default=0.0, help="the virtual film (m; a run's own by default)")
     ap.add_argument("--no-film", action="store_true", help="with a run: leave the scene's film out")
+    ap.add_argument("--against", metavar="BASE_RUN",
+                    help="with a run: compare it with another run of the same set-up row by row, each against its "
+                         "own reference (the bulk-modulus table of docs/verification.md)")
     ap.add_argument("--compressible", action="store_true",
                     help="with a run: its fluid's Tait compression at sigma0 + the mean net pressure (the vertices' "
                          "fluid is incompressible)")
@@ -385,7 +421,10 @@ def main():
         convergence()
         return
     if a.run:
-        compare(a.run, a.rho, not a.no_film, a.compressible)
+        if a.against:
+            against(a.run, a.against, a.rho, not a.no_film, a.compressible)
+        else:
+            compare(a.run, a.rho, not a.no_film, a.compressible)
         return
     need = [k for k in ("E", "nu", "mu", "Q", "notch", "times") if getattr(a, k) is None]
     if need:
