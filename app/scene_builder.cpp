@@ -364,12 +364,12 @@ BuiltScene build_scene(const problem::Problem& p) {
               "#   " +
                   approx(growth) + " cell and grows by " + approx(growth) + " cell (it leads the front by up to " +
                   approx(200 * growth * h / (3 * p.notch_m())) + "% of three notch lengths)" +
-                  std::string(settle > 0 ? ", and lets the opening follow (2 transits)" : "") +
+                  std::string(settle > 0 ? ", and lets the opening follow, releasing the step over 2 transits" : "") +
                   (d.viscosity_dominated ? "" : " (Km < 2: the closure of the nearer vertex)") + ".\n"
             : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
               "#   the tip waits for the fluid within " +
                   approx(growth) + " cell, grows by " + approx(growth) +
-                  " cell and lets the opening follow (2 transits);\n"
+                  " cell and lets the opening follow, releasing the step over 2 transits;\n"
                   "#   the faces' opening is read from the material.\n")
     << "#   damping " << approx(d.damping) << " /s: critical for the body's lowest mode (" << approx(omega) << " rad/s)"
     << (settle > 0 ? " or, with toughness, for the crack's own quarter-wave mode at three notch lengths" : "")
@@ -409,7 +409,7 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "    damping { grid_alpha_per_s: " << num(d.damping) << " pic_fraction: 0.5 }\n"
     << "    fracture { j_inner_cells: 1 j_outer_cells: 3 propagate: true growth_cells: " << num(growth)
     << " check_interval: 2 direction: STRAIGHT\n               max_lag_cells: " << num(growth)
-    << (settle > 0 ? " settle_transits: 2" : "") << " surfaces_from_material: true"
+    << (settle > 0 ? " settle_transits: 2 release_transits: 2" : "") << " surfaces_from_material: true"
     << " }\n"
     << (both ? "    cracks { x_m: [" + num(-p.notch_m()) + ", 0, " + num(p.notch_m()) +
                    "] y_m: [0, 0, 0] start_is_tip: true end_is_tip: true inlet_vertex: 1 }   # the well at x = 0\n"

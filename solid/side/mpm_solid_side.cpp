@@ -311,6 +311,7 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
   c.fracture.straight = s.fracture().direction() == scene::FractureSpec::STRAIGHT;
   if (s.fracture().has_max_lag_cells()) c.fracture.max_lag_cells = s.fracture().max_lag_cells();
   c.fracture.settle_transits = s.fracture().settle_transits();
+  c.fracture.release_transits = s.fracture().release_transits();
   c.fracture.front_settle_transits = s.fracture().front_settle_transits();
   c.fracture.surfaces_from_material = s.fracture().surfaces_from_material();
   c.implicit_face_stiffness = s.implicit_face_stiffness();

@@ -235,6 +235,12 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
   c.range(key + "fracture.growth_cells", f.growth_cells(), 0, 1, true, "cells");
   if (f.has_max_lag_cells()) c.range(key + "fracture.max_lag_cells", f.max_lag_cells(), 0, 1e3, false, "cells");
   c.range(key + "fracture.settle_transits", f.settle_transits(), 0, 1e3, false, "shear-wave transits of the crack");
+  c.range(key + "fracture.release_transits", f.release_transits(), 0, 1e3, false, "shear-wave transits of the crack");
+  if (std::isfinite(f.release_transits()) && f.release_transits() > f.settle_transits()) {
+    // A tip grows again only once its last step is released (one release per tip).
+    c.bad(key + "fracture.release_transits", text(f.release_transits()),
+          "at most fracture.settle_transits (" + text(f.settle_transits()) + ")");
+  }
   c.range(key + "fracture.front_settle_transits", f.front_settle_transits(), 0, 1e3, false,
           "shear-wave transits of the J domain");
   if (f.check_interval() < 1)

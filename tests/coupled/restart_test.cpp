@@ -221,6 +221,20 @@ TEST(Restart, TwoWingCrackContinuesBitForBit) {
       scratch_dir("restart-two-wing"));
 }
 
+// A growth step being released (kgd-toughness-ci, fracture.release_transits:
+// its first step, at 0.54-0.55 s, has its face load applied over 0.024 s):
+// the release's start, duration and length go through the checkpoint at
+// 0.56 s (the earlier of the two kept, at 0.56 and 0.84 s, which the restart
+// takes; checkpoints fall on output rows, hence rows every 0.01 s), and each
+// crack particle's unloaded share is derived again on loading. Without
+// either, the history differs from 0.57 s on (checked by hand).
+TEST(Restart, ReleasedGrowthStepContinuesBitForBit) {
+  expect_continued_run_equal(
+      {bin("hfmpm"), "run", source("scenarios/kgd-toughness-ci.scene"), "--set", "time.end_s=0.9", "--set",
+       "output.interval_s=0.01", "--set", "output.checkpoint_interval_s=0.28", "--set", "output.exchange_log=true"},
+      scratch_dir("restart-release"));
+}
+
 // `hfmpm coupler --restart DIR` with the sides started by hand: the coupler
 // continues from its checkpoint, each side reads its own file under its output
 // directory (here the coupler's, from the Welcome), and the run ends as the

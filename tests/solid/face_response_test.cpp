@@ -44,13 +44,20 @@ std::vector<double> predicted(const Solver& s, const std::vector<double>& p, dou
   return w;
 }
 
-void expect_exact_prediction(const SolidConfig& config) {
+// grow_after: > 0: after opening, grow the tip once (propagate() by hand)
+// and take that many steps before the check.
+void expect_exact_prediction(const SolidConfig& config, int grow_after = 0, double bound = 1e-9) {
   Solver s(config);
-  const std::size_t n = s.cracks()[0].size();
   // Open the crack and leave it moving: a few steps under 1 MPa.
-  s.set_crack_pressure(0, std::vector<double>(n, 1e6));
+  s.set_crack_pressure(0, std::vector<double>(s.cracks()[0].size(), 1e6));
   const double dt = s.stable_dt();
   for (int i = 0; i < 40; ++i) s.step(dt);
+  if (grow_after > 0) {
+    ASSERT_EQ(s.propagate(), 1);
+    s.set_crack_pressure(0, std::vector<double>(s.cracks()[0].size(), 1e6));
+    for (int i = 0; i < grow_after; ++i) s.step(dt);
+  }
+  const std::size_t n = s.cracks()[0].size();
   for (int variant = 0; variant < 3; ++variant) {
     std::vector<double> p(n);
     for (std::size_t k = 0; k < n; ++k) {
@@ -71,7 +78,7 @@ void expect_exact_prediction(const SolidConfig& config) {
     }
     ASSERT_GT(change, 0);
     std::printf("variant %d: opening change %.3e m, prediction error %.3e m\n", variant, change, error);
-    EXPECT_LT(error, 1e-9 * change) << "pressure variant " << variant << ": change " << change;
+    EXPECT_LT(error, bound * change) << "pressure variant " << variant << ": change " << change;
   }
 }
 
@@ -85,6 +92,27 @@ TEST(FaceResponse, PredictsTheOpeningWithTheSurfacesDriftingToTheMaterial) {
   SolidConfig c = opened_edge_crack();
   c.fracture.surfaces_from_material = true;
   expect_exact_prediction(c);
+}
+
+// While a growth step's face load is being applied (fracture.release_transits:
+// the crack particles within the grown quarter cell of the tip take 1 - r of
+// their tributary load, r falling from 1 to 0 over 2 L / c_s, about 41 steps
+// here), the response reports the same reduced load, so the prediction stays
+// exact: checked 10-12 steps into the release (r about 0.85). The grown
+// crack's round-off is larger than the cut one's (measured 4e-9 of the
+// opening change with and without the release; asserted 1e-8); a response
+// that missed the release's factor (checked by hand) is off by 18% of the
+// change (3.0e-7 m on 1.65e-6 m).
+TEST(FaceResponse, PredictsTheOpeningWhileAGrowthStepsLoadIsApplied) {
+  SolidConfig c = opened_edge_crack();
+  c.materials[0].toughness = 1e-9;  // propagate() grows when asked
+  c.fracture.straight = true;
+  c.fracture.growth_cells = 0.25;
+  c.fracture.settle_transits = 2;
+  c.fracture.release_transits = 2;
+  expect_exact_prediction(c, 10, 1e-8);
+  c.fracture.release_transits = 0;  // and without the release
+  expect_exact_prediction(c, 10, 1e-8);
 }
 
 TEST(FaceResponse, IsBandedAndSplittingTheStepChangesNothing) {

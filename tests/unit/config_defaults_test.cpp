@@ -128,6 +128,7 @@ Keys<SolidConfig> fracture_keys() {
             }},
            {"max_lag_cells", [](const SolidConfig& c) { return c.fracture.max_lag_cells; }},
            {"settle_transits", [](const SolidConfig& c) { return c.fracture.settle_transits; }},
+           {"release_transits", [](const SolidConfig& c) { return c.fracture.release_transits; }},
            {"front_settle_transits", [](const SolidConfig& c) { return c.fracture.front_settle_transits; }},
            {"surfaces_from_material", [](const SolidConfig& c) { return c.fracture.surfaces_from_material ? 1 : 0; }}},
           {{"max_lag_cells", -1}}};  // unset: no limit

@@ -277,6 +277,7 @@ TEST(Versions, SceneSchemaIsBumpedWithTheSchema) {
       {6, 17530128371913356884ull},  // fluid lag TIP_ASYMPTOTE_MATCHED
       {7, 2265630044900314741ull},   // fluid.mpm.affine_transfer
       {8, 1754681767318198518ull},   // cracks.inlet_vertex
+      {9, 13498048890745661301ull},  // fracture.release_transits
   };
   ASSERT_TRUE(fingerprints.count(hfmpm::proto::kSceneSchemaVersion))
       << "no fingerprint recorded for scene schema version " << hfmpm::proto::kSceneSchemaVersion;

@@ -178,6 +178,8 @@ TEST(SceneBuilder, ToughnessDominatedSceneTakesTheToughnessClosure) {
   EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);
   EXPECT_DOUBLE_EQ(mpm.fracture().growth_cells(), 0.25);
   EXPECT_DOUBLE_EQ(mpm.fracture().settle_transits(), 2);
+  // Each step released over the wait (docs/solid.md, "Growth": nodal release).
+  EXPECT_DOUBLE_EQ(mpm.fracture().release_transits(), 2);
   // The faces read from the material (docs/verification.md, "A growth step
   // without a jolt").
   EXPECT_TRUE(mpm.fracture().surfaces_from_material());
@@ -257,6 +259,7 @@ TEST(SceneBuilder, TransitionTakesTheClosureOfTheNearerVertex) {
   EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE_MATCHED);
   EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e5);
   EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().settle_transits(), 2);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().release_transits(), 2);
   EXPECT_TRUE(s.solid().mpm().fracture().surfaces_from_material());
   p.mutable_rock()->set_toughness_pa_sqrt_m(25e3 * 2.5 / 7.61);  // Km 2.5
   EXPECT_EQ(checked(build_scene(p)).fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);

@@ -111,6 +111,11 @@ void Solver::save(StateWriter& out) const {
   std::vector<double> arrived;
   for (const auto& a : front_arrived_at_) arrived.insert(arrived.end(), a.begin(), a.end());
   out.put("front_arrived_at", arrived);
+  std::vector<double> released;  // per crack and (start, end) tip: t0, tau, length
+  for (const auto& tips : releases_) {
+    for (const auto& r : tips) released.insert(released.end(), {r.t0, r.tau, r.length});
+  }
+  out.put("releases", released);
   out.put("anchored_at", anchored_at_);
   std::vector<Vec2> drift;  // per crack particle, above then below (the crack's size known)
   for (std::size_t c = 0; c < cracks_.size(); ++c) {
@@ -211,6 +216,16 @@ void Solver::load(const StateReader& in) {
   front_arrived_at_.resize(arrived.size() / 2);
   for (std::size_t i = 0; i < front_arrived_at_.size(); ++i)
     front_arrived_at_[i] = {arrived[2 * i], arrived[2 * i + 1]};
+  std::vector<double> released;
+  in.get("releases", released);
+  if (released.size() % 6 != 0) throw std::runtime_error("checkpoint array releases has a size not a multiple of 6");
+  releases_.resize(released.size() / 6);
+  for (std::size_t i = 0; i < releases_.size(); ++i) {
+    for (std::size_t e = 0; e < 2; ++e) {
+      const double* r = &released[6 * i + 3 * e];
+      releases_[i][e] = {r[0], r[1], r[2]};
+    }
+  }
   in.get("anchored_at", anchored_at_);
   std::vector<double> drift;
   in.get("surface_drift", drift);
@@ -285,6 +300,7 @@ void Solver::load(const StateReader& in) {
   expect_size(touched_in_, nodes, "touched_in");
   in.get("active", active_);
   in.get("stencil_fields", stencil_fields_);
+  update_releases();  // derived from the time, the releases and the cracks (as begin_step does)
 }
 
 }  // namespace hfmpm::solid::mpm

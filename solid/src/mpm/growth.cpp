@@ -41,6 +41,7 @@ int Solver::propagate() {
   std::vector<std::array<Vec2, 2>> cut;  // the new segments, old tip to new
   if (grown_at_.size() != cracks_.size()) grown_at_.resize(cracks_.size(), {-kForever, -kForever});
   if (front_arrived_at_.size() != cracks_.size()) front_arrived_at_.resize(cracks_.size(), {-kForever, -kForever});
+  if (releases_.size() != cracks_.size()) releases_.resize(cracks_.size());
   // Each crack's length before this check grows any tip: the settling wait of
   // its second tip must not count the growth of its first in the same check
   // (it did, and the two tips of a point-symmetric crack grew at alternate
@@ -132,6 +133,13 @@ int Solver::propagate() {
       crack.prepend(next, reference);
     }
     cut.push_back({tip.position, next});
+    if (config_.fracture.release_transits > 0) {
+      // The new part's face load is applied over release_transits x L / c_s,
+      // L the crack's length before the step (Solver::update_releases).
+      const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
+      releases_[tip.crack][tip.at_end ? 1 : 0] = {t_, config_.fracture.release_transits * lengths[tip.crack] / c_s,
+                                                  config_.fracture.growth_cells * h};
+    }
     grown_at = t_;
     front_arrived_at_[tip.crack][tip.at_end ? 1 : 0] = -kForever;
     ++added;

@@ -220,6 +220,7 @@ void Solver::begin_step() {
     edge_loads();
   } else {
     for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h, 1e-6 * config_.grid.h);
+    update_releases();
     p2g<true>();
     if (config_.fracture.surfaces_from_material) anchor_crack_surfaces();
     contact(0.0);  // on the extrapolated momenta

@@ -82,19 +82,73 @@ void Solver::spread_face_force(const Crack& crack, std::size_t k, int side, cons
   }
 }
 
+// A growth step released over time (Fracture::release_transits): the face
+// load (the fluid's pressure, and the in-situ traction under
+// in_situ_reference) on the part of the crack within `length` of the tip
+// that grew is applied with the weight 1 - r, r = (1 + cos(pi s)) / 2,
+// s = (t - t0) / tau, as a tip advancing steadily over tau would load it
+// (its loaded length growing with time; the half-cosine is the smooth form of
+// that ramp). The crack particles there take (1 - r) of their tributary
+// length's load in crack_loads, face_response and implicit_face_stiffness
+// alike, so the implicit interface solve sees the load the solid applies.
+// Loaded at once, the new part opens within a few h / c: a zero-lag fluid
+// cannot follow, its pressure at the tip drops by a third, and that dip runs
+// to the mouth as a wave (a toughness KGD's inlet pressure dipped 10% at
+// every growth step). A load switched on over a half-cosine of duration tau
+// leaves a mode of period T ringing with |cos(pi tau / T) / (1 - (2 tau /
+// T)^2)| of a sudden load's amplitude (docs/solid.md, "Growth").
+namespace {
+double release_remaining(double t, double t0, double tau, double length) {
+  constexpr double kPi = 3.14159265358979323846;
+  if (!(tau > 0) || !(length > 0) || !(t < t0 + tau)) return 0;
+  return 0.5 * (1 + std::cos(kPi * std::clamp((t - t0) / tau, 0.0, 1.0)));
+}
+}  // namespace
+
+void Solver::update_releases() {
+  unloaded_.resize(cracks_.size());
+  for (std::size_t c = 0; c < cracks_.size(); ++c) {
+    unloaded_[c].clear();
+    if (c >= releases_.size()) continue;
+    const Crack& crack = cracks_[c];
+    const std::size_t n = crack.size();
+    std::vector<double> arc;
+    for (int end = 0; end < 2; ++end) {
+      const Release& r = releases_[c][static_cast<std::size_t>(end)];
+      const double remaining = release_remaining(t_, r.t0, r.tau, r.length);
+      if (remaining <= 0) continue;
+      if (arc.empty()) arc = arc_length(crack.plane());
+      if (unloaded_[c].empty()) unloaded_[c].assign(n, 0.0);
+      for (std::size_t k = 0; k < n; ++k) {
+        // Particle k's tributary part of the crack, as distances from this tip;
+        // the part within r.length of it is unloaded by `remaining`.
+        const double before = k > 0 ? 0.5 * (arc[k] - arc[k - 1]) : 0.0;
+        const double after = k + 1 < n ? 0.5 * (arc[k + 1] - arc[k]) : 0.0;
+        const double d = end ? arc.back() - arc[k] : arc[k] - arc.front();
+        const double lo = std::max(0.0, d - (end ? after : before));
+        const double hi = std::min(r.length, d + (end ? before : after));
+        if (!(hi > lo)) continue;
+        unloaded_[c][k] += remaining * (hi - lo);
+      }
+    }
+  }
+}
+
 void Solver::crack_loads(bool in_situ, bool pressure) {
   const bool with_in_situ = in_situ && config_.in_situ_reference;
-  for (const auto& crack : cracks_) {
+  for (std::size_t c = 0; c < cracks_.size(); ++c) {
+    const Crack& crack = cracks_[c];
     for (std::size_t k = 0; k < crack.size(); ++k) {
       const Vec2 n = crack.normal(k);
       // Pressure opens the crack: +n into the field above, -n into the field
       // below. With the in-situ stress as reference the faces also give up
       // the in-situ traction sigma0 n that the uncut body carried across them.
+      // A part being released (update_releases) takes only its loaded share.
       Vec2 t = Vec2::Zero();
       if (pressure) t += crack.face_pressure(k) * n;
       if (with_in_situ) t += traction(in_situ_stress(crack.plane()[k]), n);
-      if (t.squaredNorm() == 0) continue;
-      const Vec2 force = crack.tributary_length(k) * t;
+      const Vec2 force = (crack.tributary_length(k) - unloaded_length(c, k)) * t;
+      if (force.squaredNorm() == 0) continue;
       for (int side : {1, -1}) spread_face_force(crack, k, side, side * force);
     }
   }
@@ -112,7 +166,7 @@ Solver::FaceResponse Solver::face_response(std::size_t c) const {
   // j gives it (as crack_loads spreads the load), for every j that loads it.
   std::unordered_map<std::size_t, std::vector<std::pair<std::size_t, Vec2>>> loaded;
   for (std::size_t j = 0; j < count; ++j) {
-    const Vec2 force = crack.tributary_length(j) * crack.normal(j);
+    const Vec2 force = (crack.tributary_length(j) - unloaded_length(c, j)) * crack.normal(j);
     for (int side : {1, -1}) {
       const FaceShares s = face_shares(crack, j, side);
       for (int i = 0; i < s.count; ++i) {
@@ -238,11 +292,12 @@ void Solver::implicit_face_stiffness(double dt) {
   };
   std::vector<FaceNode> faces;
   if (face_slot_.size() != field0_.mass.size()) face_slot_.assign(field0_.mass.size(), -1);
-  for (const auto& crack : cracks_) {
+  for (std::size_t ci = 0; ci < cracks_.size(); ++ci) {
+    const Crack& crack = cracks_[ci];
     for (std::size_t k = 0; k < crack.size(); ++k) {
       const double s = crack.pressure_stiffness()[k];
       if (s <= 0 || crack.face_pressure(k) <= 0) continue;
-      const double weight = s * crack.tributary_length(k);
+      const double weight = s * (crack.tributary_length(k) - unloaded_length(ci, k));
       const Vec2 n = crack.normal(k);
       for (int side : {1, -1}) {
         const int slot = side > 0 ? 0 : 1;

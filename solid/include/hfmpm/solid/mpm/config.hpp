@@ -89,6 +89,11 @@ struct Fracture {
   // scaled density): the time the crack's opening needs to follow the new
   // length. 0: no wait.
   double settle_transits = 0;
+  // The face load on a grown part of a crack is applied over
+  // release_transits x L / c_s (L the crack's length before the step), rising
+  // as a half-cosine, as a tip advancing steadily over that time would apply
+  // it (Solver::update_releases). 0: at once. At most settle_transits.
+  double release_transits = 0;
   // With the zero-lag closure (max_lag_cells >= 0 and a fluid front), for
   // tips that kink (not straight): once the front has come within the
   // allowed lag, the tip grows only after this many shear-wave transits of

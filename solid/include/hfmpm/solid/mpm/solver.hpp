@@ -199,6 +199,13 @@ class Solver {
   // Face loads: the in-situ traction the cut gives up (in_situ_reference) and
   // the fluid's pressure, each when asked.
   void crack_loads(bool in_situ, bool pressure);
+  // Per crack particle, the part of its tributary length not yet loaded by
+  // a release in progress (Fracture::release_transits): it takes that much
+  // less of the face load. Set by update_releases at begin_step.
+  void update_releases();
+  double unloaded_length(std::size_t c, std::size_t k) const {
+    return c < unloaded_.size() && k < unloaded_[c].size() ? unloaded_[c][k] : 0.0;
+  }
   FaceShares face_shares(const Crack& crack, std::size_t k, int side) const;
   void spread_face_force(const Crack& crack, std::size_t k, int side, const Vec2& force);
   void implicit_face_stiffness(double dt);
@@ -243,6 +250,14 @@ class Solver {
   SolidConfig config_;
   std::vector<TipResult> last_tips_;
   std::vector<std::array<double, 2>> grown_at_;  // s, last growth of each crack's (start, end) tip
+  // The release of each crack's (start, end) tip's last growth step
+  // (Fracture::release_transits): from t0 over tau (s), the part of the
+  // crack within `length` (m) of the tip.
+  struct Release {
+    double t0 = 0, tau = 0, length = 0;
+  };
+  std::vector<std::array<Release, 2>> releases_;
+  std::vector<std::vector<double>> unloaded_;  // m, per crack and crack particle (update_releases)
   // s, when the fluid front came within the end tip's allowed lag (-inf: not
   // since its last growth); Fracture::front_settle_transits.
   std::vector<std::array<double, 2>> front_arrived_at_;  // s, per crack (start, end) tip
