@@ -115,6 +115,79 @@ TEST(FaceResponse, PredictsTheOpeningWhileAGrowthStepsLoadIsApplied) {
   expect_exact_prediction(c, 10, 1e-8);
 }
 
+// The load itself, against its exact share: two twins, the same crack grown
+// once by a quarter cell (appended: the tip segment was half a cell), one
+// with the release and one without. A unit pressure at crack particle j
+// loads its tributary length less the part of it within the quarter cell of
+// the tip, weighted by r = (1 + cos(pi s)) / 2: the tip particle's tributary
+// (h / 8) lies wholly in it, the old tip's (h / 8 + h / 4) for h / 8, the
+// rest not at all. So every column j of the released twin's compliance is the
+// other's times 1 - r (its part in the grown quarter cell) / (its tributary
+// length), from the crack's own geometry: at the step (s = 0) 0, about 2/3
+// and 1 (asserted to 1e-12 of the largest entry); ten steps later, the
+// twins' geometries differing by the motion of those steps, to 1e-3 of the
+// largest entry (s = 0.21 there: the half-cosine's 1 - r is 0.107, a linear
+// ramp's 0.21: 0.1 of the tip particle's column, whose entries reach 8e-3
+// against a tolerance of 1.6e-5; a release that did nothing misses the
+// tip's column at s = 0 outright).
+TEST(FaceResponse, AGrowthStepsLoadIsTheShareOfTheGrownPartNotYetReleased) {
+  SolidConfig c = opened_edge_crack();
+  c.materials[0].toughness = 1e-9;  // propagate() grows when asked
+  c.fracture.straight = true;
+  c.fracture.growth_cells = 0.25;
+  c.fracture.settle_transits = 2;
+  SolidConfig r = c;
+  r.fracture.release_transits = 2;
+  Solver at_once(c), released(r);
+  const double dt = at_once.stable_dt(), h = c.grid.h;
+  for (Solver* s : {&at_once, &released}) {
+    s->set_crack_pressure(0, std::vector<double>(s->cracks()[0].size(), 1e6));
+    for (int i = 0; i < 40; ++i) s->step(dt);
+    ASSERT_EQ(s->propagate(), 1);
+  }
+  const double t0 = released.time(), length = 0.3;  // the crack's length before the step
+  const double tau = 2 * length / std::sqrt(kRock.shear_modulus() / kRock.density);
+  const std::size_t n = released.cracks()[0].size();
+  ASSERT_NEAR((released.cracks()[0].plane()[n - 1] - released.cracks()[0].plane()[n - 2]).norm(), 0.25 * h, 1e-6 * h);
+  for (int steps : {0, 10}) {
+    for (int i = 0; i < steps; ++i) {
+      for (Solver* s : {&at_once, &released}) {
+        s->set_crack_pressure(0, std::vector<double>(n, 1e6));
+        s->step(dt);
+      }
+    }
+    at_once.begin_step();
+    released.begin_step();
+    const auto a = at_once.face_response(0), b = released.face_response(0);
+    ASSERT_EQ(a.band, b.band);
+    const double s = (released.time() - t0) / tau, remaining = 0.5 * (1 + std::cos(kPi * s));
+    double largest = 0;
+    for (double v : a.compliance) largest = std::max(largest, std::abs(v));
+    const std::size_t row = 2 * a.band + 1;
+    // The grown part is the quarter cell nearest the tip; the tip segment is
+    // that quarter cell (to 1e-6 h), so it holds the tip particle's tributary
+    // half of it and the other half of the old tip's.
+    const Crack& crack = released.cracks()[0];
+    const double half = 0.5 * (crack.plane()[n - 1] - crack.plane()[n - 2]).norm();
+    for (std::size_t k = 0; k < n; ++k) {
+      for (std::size_t j = k >= a.band ? k - a.band : 0; j <= std::min(n - 1, k + a.band); ++j) {
+        const double in_grown = j + 1 == n ? half : j + 2 == n ? 0.25 * h - half : 0.0;
+        const double factor = 1 - remaining * in_grown / crack.tributary_length(j);
+        const std::size_t e = k * row + j + a.band - k;
+        EXPECT_NEAR(b.compliance[e], factor * a.compliance[e], (steps == 0 ? 1e-12 : 1e-3) * largest)
+            << "s = " << s << ", response at " << k << " to pressure at " << j;
+      }
+    }
+    std::printf("s = %.3f: the grown part's share 1 - r = %.4f checked over %zu crack particles\n", s, 1 - remaining,
+                n);
+    // Finish the steps begun (the next iteration steps both on).
+    for (Solver* s2 : {&at_once, &released}) {
+      s2->set_crack_pressure(0, std::vector<double>(n, 1e6));
+      s2->step(dt);
+    }
+  }
+}
+
 TEST(FaceResponse, IsBandedAndSplittingTheStepChangesNothing) {
   Solver a(opened_edge_crack()), b(opened_edge_crack());
   const std::size_t n = a.cracks()[0].size();
