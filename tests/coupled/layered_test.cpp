@@ -10,14 +10,16 @@
 //   the path bends toward the interface;
 // - in the softer layer the K_II has the other sign: the crack turns away from
 //   the stiff layer (it stays in the soft one);
-// - started in the stiff layer, the 1e-3 Pa s crack turns to reach the bond
-//   (the paper's second observation; +4.15 m at the tip at the scene's step,
-//   +3.81 m at half of it), the 1e-2 Pa s one turns less (+2.5 m);
+// - started in the stiff layer, the crack turns to reach the bond (the
+//   paper's second observation): at 1e-3 and at 1e-2 Pa s the tip ends at
+//   +3.74 and +3.88 m, within a cell of the bond at y = 4 m. (Until the
+//   pressure inlet became a well, fluid.md "Pressure inlet", the 1e-2 Pa s
+//   crack turned only to +2.5 m by the end: the inflow's free kinetic energy
+//   drove the crack's dynamic run from 3 s on, and the path with it.);
 // - a more viscous fluid turns it more near the notch (the method paper's
 //   finding): two cells past the notch (x = 6 m, which every growing crack
 //   reaches) the path of mu = 1e-2 Pa s lies further toward the soft layer
-//   than that of 1e-3 Pa s (+0.36 against +0.29 m; +0.36 against +0.28 m at
-//   half the step);
+//   than that of 1e-3 Pa s (+0.367 against +0.290 m);
 // - a fluid of 1 Pa s does not enter the crack fast enough to grow it by the
 //   end time under the same ramp.
 // Bounds, in cells (h = 1 m): a crack "grew" when it went more than 2 cells past
@@ -26,7 +28,7 @@
 // counts when the path is more than a quarter cell off its line (crack
 // particles are half a cell apart and each growth step may kink); the
 // viscosity effect at x = 6 m is asserted as more than a twentieth of a cell
-// (0.066 and 0.078 m at the scene's step and half of it); "reaching the bond"
+// (0.077 m); "reaching the bond"
 // as coming within a cell of it. The scene runs the implicit interface scheme
 // at 0.9 of the solid's step; at half of it every path of the sweep lies
 // within 0.43 cell of the scene's (docs/verification.md, "Layered medium").
@@ -142,8 +144,9 @@ TEST(Layered, StartedInTheStiffLayerItTurnsTowardTheSoftOneAndMoreSoWithAMoreVis
     EXPECT_GT(p->y.back(), kQuarterCell) << "the tip ends toward the soft layer (y > 0)";
     EXPECT_GT(*std::min_element(p->y.begin(), p->y.end()), -kQuarterCell) << "it never turns away from it";
   }
-  EXPECT_GT(*std::max_element(thin.y.begin(), thin.y.end()), kInterface - kCell) << "1e-3 Pa s reaches the bond";
-  EXPECT_LT(*std::max_element(thick.y.begin(), thick.y.end()), kInterface - kCell) << "1e-2 Pa s turns less";
+  for (const Path* p : {&thin, &thick}) {
+    EXPECT_GT(*std::max_element(p->y.begin(), p->y.end()), kInterface - kCell) << "it reaches the bond";
+  }
   const double d_thin = thin.y_at(at), d_thick = thick.y_at(at);
   std::printf("deviation at x = %.2f m: mu 1e-3 %+.3f m, mu 1e-2 %+.3f m; mean offset from x = 4 m: %+.3f m, %+.3f m\n",
               at, d_thin, d_thick, thin.mean_y(kNotchTip, at), thick.mean_y(kNotchTip, at));

@@ -132,8 +132,8 @@ bool FluidSolver::interface_trial(const std::vector<double>& P, double dt, Trial
     if (in.kind == InletConfig::Kind::FlowRate) {
       t.mass[0] += inflow_mass(dt);
     } else if (t.a[0] > 0) {
-      const double p_in = std::max(0.0, in.pressure(t_ + dt));
-      t.mass[0] += rho0 / eos_.volume_ratio(p_in) * integrate(arc, t.width, 0.0, t.a[0]);
+      const double p_m = entrance_pressure(t_ + dt, t.v[0]);  // inlet(): the static pressure at the mouth
+      t.mass[0] += rho0 / eos_.volume_ratio(p_m) * integrate(arc, t.width, 0.0, t.a[0]);
     } else if (t.a[0] < 0) {
       const double all = integrate(arc, t.width, t.a[0], t.b[0]), outside = integrate(arc, t.width, t.a[0], 0.0);
       t.mass[0] -= t.mass[0] * (all > 0 ? outside / all : -t.a[0] / (t.b[0] - t.a[0]));

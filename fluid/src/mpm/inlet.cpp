@@ -9,10 +9,19 @@
 //     from J = rho0 l w / m, so the pressure at the mouth is whatever pushes
 //     rho0 Q into the crack; the mouth is held at that pressure (the well is
 //     in equilibrium with the inlet particle);
-//   pressure inlet: the mouth is held at p_in(t) (a traction p_in w(0) on node
-//     0); the fluid that moved in over [0, a] (a = where the rear end went)
-//     enters at the inlet density rho0 / J(p_in); if the rear end moved out
-//     (a < 0), the part outside leaves with its share of the particle's mass.
+//   pressure inlet: p_in(t) is the well's pressure, the fluid at rest there.
+//     The mouth is held at its static pressure p_m = p_in - rho v^2 / 2 for
+//     inflow at the mouth's velocity v after the last step (Bernoulli from
+//     the well; p_in for outflow), a traction p_m w(0) on node 0; the fluid
+//     that moved in over [0, a] (a = where the rear end went) enters at the
+//     density rho0 / J(p_m) and with the grid's velocity, so that what comes
+//     in brings p_m + rho v^2 / 2 = p_in per unit volume, pressure work and
+//     kinetic energy together. (Held at p_in itself, the inflow's kinetic
+//     energy came for free: a thin fluid entering a crack at 87 m/s under
+//     2.3 MPa, whose rho v^2 / 2 is 3.8 MPa, gave the solid more kinetic
+//     energy than the well had supplied; docs/fluid.md, "Pressure inlet".)
+//     If the rear end moved out (a < 0), the part outside leaves with its
+//     share of the particle's mass.
 // Mass is conserved exactly: the added masses are summed into
 // injected_mass(), and splits and merges only redistribute mass.
 // When the inlet particle reaches twice particle_length, its front
@@ -30,12 +39,26 @@
 
 namespace hfmpm::fluid::mpm {
 
+double FluidSolver::entrance_pressure(double t, double v) const {
+  const double p_in = std::max(0.0, config_.inlet.pressure(t));
+  if (!(v > 0)) return p_in;
+  const double rho = config_.density / eos_.volume_ratio(p_in);
+  return std::max(0.0, p_in - 0.5 * rho * v * v);
+}
+
 double FluidSolver::mouth_pressure() const {
-  if (config_.inlet.kind == InletConfig::Kind::Pressure) return std::max(0.0, config_.inlet.pressure(t_));
+  if (config_.inlet.kind == InletConfig::Kind::Pressure) {
+    // The fluid's velocity at the mouth: the inlet particle's there (the
+    // nodal velocities do not outlive a new crack from the solid).
+    const auto& P = particles_;
+    const double v = P.size() > 0 ? P.velocity[0] + (config_.affine ? P.gradient[0] * (0.0 - P.s[0]) : 0.0) : 0.0;
+    return entrance_pressure(t_, v);
+  }
   return particles_.size() > 0 ? particles_.pressure[0] : 0.0;
 }
 
 double FluidSolver::inlet_pressure() const {
+  if (config_.inlet.kind == InletConfig::Kind::Pressure) return std::max(0.0, config_.inlet.pressure(t_));
   // The implicit step reports the mouth pressure it solved over the step.
   if (config_.implicit_interface && !nodal_pressure_.empty()) return nodal_pressure_[0];
   return mouth_pressure();
@@ -96,8 +119,8 @@ void FluidSolver::inlet(double dt) {
   if (in.kind == InletConfig::Kind::FlowRate) {
     dm = inflow_mass(dt);
   } else if (a > 0) {
-    const double p_in = std::max(0.0, in.pressure(t_ + dt));
-    dm = rho0 / eos_.volume_ratio(p_in) * grid_.width_integral(0, a);
+    const double p_m = entrance_pressure(t_ + dt, v_new_.empty() ? 0.0 : v_new_[0]);
+    dm = rho0 / eos_.volume_ratio(p_m) * grid_.width_integral(0, a);
   }
   if (a < 0 && in.kind == InletConfig::Kind::Pressure) {
     const double outside = grid_.width_integral(a, 0), all = grid_.width_integral(a, b);

@@ -75,8 +75,7 @@ void FluidSolver::project_pressure(const std::vector<double>& pp, std::vector<do
     for (std::size_t i = 0; i < n; ++i)
       if (grid_.arc()[i] > front) nodal[i] = config_.lag_pressure;
   }
-  const double mouth =
-      config_.inlet.kind == InletConfig::Kind::Pressure ? std::max(0.0, config_.inlet.pressure(t_)) : pp[0];
+  const double mouth = config_.inlet.kind == InletConfig::Kind::Pressure ? mouth_pressure() : pp[0];
   if (config_.lag == FluidConfig::Lag::Front) {
     const double p_front = std::min(pp[particles_.size() - 1], mouth);
     // Only up to the first node beyond the front: the crack the fluid is

@@ -21,7 +21,13 @@ struct InletConfig {
   // (mass rate rho0 Q). With a symmetry plane at the mouth, the half of the
   // total rate that enters the simulated wing.
   TimeFunction flow_rate = TimeFunction::constant(0);
-  // Pressure: p_in(t), Pa (values < 0 act as 0: no suction).
+  // Pressure: p_in(t), Pa (values < 0 act as 0: no suction), the pressure of
+  // the well or reservoir that feeds the mouth, where the fluid is at rest.
+  // Fluid flowing in at speed v has the static pressure p_in - rho v^2 / 2 at
+  // the mouth (Bernoulli along the streamline from the well); fluid flowing
+  // back out has p_in (it stops in the well, its kinetic energy lost there).
+  // So the inlet gives the fluid p_in per unit volume of energy, kinetic and
+  // pressure work together, as the energy check counts it.
   TimeFunction pressure = TimeFunction::constant(0);
   // Virtual pre-opening: crack nodes with arc length <= pre_opening_length
   // (m; the mouth node always) are pre_opening (m) wider for the fluid than

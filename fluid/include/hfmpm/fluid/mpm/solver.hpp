@@ -194,8 +194,9 @@ class FluidSolver {
   double front_counter_pressure() const;
   // m/s, the front's speed: the mass-weighted mean velocity of the fluid within the solid's cell of the front.
   double front_speed() const;
-  // Pa, the pressure held at the mouth: p_in(t), or for a flow-rate inlet
-  // the inlet particle's pressure.
+  // Pa, the inlet's pressure: the well's p_in(t) behind a pressure inlet
+  // (the mouth's static pressure is below it by the inflow's rho v^2 / 2,
+  // nodal_pressure()[0]), or for a flow-rate inlet the mouth's, solved.
   double inlet_pressure() const;
   // m^2/s, zero-pressure volume per second that came in over the last advance() (or step()).
   double inlet_flux() const { return inlet_flux_; }
@@ -225,6 +226,10 @@ class FluidSolver {
   void g2p(double dt);
   // inlet.cpp
   double mouth_pressure() const;  // boundary pressure at the mouth for the force
+  // Pa, the static pressure at the mouth behind a pressure inlet at time t
+  // with the fluid's velocity v there (m/s, > 0 inward): p_in(t) - rho v^2 / 2
+  // for inflow, p_in(t) for outflow, at least 0 (InletConfig::pressure).
+  double entrance_pressure(double t, double v) const;
   bool seed(double dt);
   void inlet(double dt);
   void outlet(double dt);
