@@ -122,5 +122,25 @@ TEST(FaceStiffness, GrowthEnergyDropsTheShareOfANegativeKI) {
   EXPECT_DOUBLE_EQ(growth_energy(tip, true), 0);         // closed, mode I only: nothing
 }
 
+// growth_direction_known: a kinking tip's K's must carry J within a factor 10.
+TEST(FaceStiffness, AGrowthDirectionNeedsKsThatCarryJWithinAFactorTen) {
+  TipResult tip;
+  tip.j = 10;
+  tip.modulus = 1e10;
+  tip.k1 = std::sqrt(10 * 1e10);  // a crack-tip field: (K_I^2 + K_II^2) / E' = J
+  EXPECT_TRUE(growth_direction_known(tip));
+  tip.k1 = 0.6e5;  // (3.6e9 + 6.4e9) / 1e10 = 1 = J / 10: just enough
+  tip.k2 = -0.8e5;
+  EXPECT_TRUE(growth_direction_known(tip));
+  tip.k1 = -1035;  // the layered hook's step (0.98 s): J = 10-14 J/m^2, K's a hundredth of sqrt(J E')
+  tip.k2 = -7563;
+  EXPECT_FALSE(growth_direction_known(tip));
+  tip.k1 = std::sqrt(100 * 1e10);  // ten times J: just within
+  tip.k2 = 0;
+  EXPECT_TRUE(growth_direction_known(tip));
+  tip.k1 = std::sqrt(510 * 1e10);  // the soft start's step at 3.92 s (1e-2 Pa s): 51 times J
+  EXPECT_FALSE(growth_direction_known(tip));
+}
+
 }  // namespace
 }  // namespace hfmpm::solid::mpm

@@ -65,6 +65,11 @@ inline constexpr double kIrwinBend = 0.5235987755982988;  // 30 deg
 // toughness.
 double growth_energy(const TipResult& tip, bool mode_one_only = false);
 
+// Whether a kinking tip's K's can set its direction: they carry J within a
+// factor 10 either way, J / 10 <= (K_I^2 + K_II^2) / E' <= 10 J (growth.cpp;
+// docs/solid.md, "Growth"). Otherwise the tip waits.
+bool growth_direction_known(const TipResult& tip);
+
 class Solver {
  public:
   explicit Solver(SolidConfig config);
