@@ -31,7 +31,7 @@
 // (0.077 m); "reaching the bond"
 // as coming within a cell of it. The scene runs the implicit interface scheme
 // at 0.9 of the solid's step; at half of it every path of the sweep lies
-// within 0.43 cell of the scene's (docs/verification.md, "Layered medium").
+// within 0.19 cell of the scene's (docs/verification.md, "Layered medium").
 #include <gtest/gtest.h>
 
 #include <algorithm>
