@@ -94,6 +94,17 @@ TEST(FaceResponse, PredictsTheOpeningWithTheSurfacesDriftingToTheMaterial) {
   expect_exact_prediction(c);
 }
 
+// The opened edge crack set to grow straight by quarter cells whenever
+// propagate() is asked, waiting two transits after each step.
+SolidConfig growing_edge_crack() {
+  SolidConfig c = opened_edge_crack();
+  c.materials[0].toughness = 1e-9;
+  c.fracture.straight = true;
+  c.fracture.growth_cells = 0.25;
+  c.fracture.settle_transits = 2;
+  return c;
+}
+
 // While a growth step's face load is being applied (fracture.release_transits:
 // the crack particles within the grown quarter cell of the tip take 1 - r of
 // their tributary load, r falling from 1 to 0 over 2 L / c_s, about 41 steps
@@ -104,11 +115,7 @@ TEST(FaceResponse, PredictsTheOpeningWithTheSurfacesDriftingToTheMaterial) {
 // that missed the release's factor (checked by hand) is off by 18% of the
 // change (3.0e-7 m on 1.65e-6 m).
 TEST(FaceResponse, PredictsTheOpeningWhileAGrowthStepsLoadIsApplied) {
-  SolidConfig c = opened_edge_crack();
-  c.materials[0].toughness = 1e-9;  // propagate() grows when asked
-  c.fracture.straight = true;
-  c.fracture.growth_cells = 0.25;
-  c.fracture.settle_transits = 2;
+  SolidConfig c = growing_edge_crack();
   c.fracture.release_transits = 2;
   expect_exact_prediction(c, 10, 1e-8);
   c.fracture.release_transits = 0;  // and without the release
@@ -131,11 +138,7 @@ TEST(FaceResponse, PredictsTheOpeningWhileAGrowthStepsLoadIsApplied) {
 // against a tolerance of 1.6e-5; a release that did nothing misses the
 // tip's column at s = 0 outright).
 TEST(FaceResponse, AGrowthStepsLoadIsTheShareOfTheGrownPartNotYetReleased) {
-  SolidConfig c = opened_edge_crack();
-  c.materials[0].toughness = 1e-9;  // propagate() grows when asked
-  c.fracture.straight = true;
-  c.fracture.growth_cells = 0.25;
-  c.fracture.settle_transits = 2;
+  const SolidConfig c = growing_edge_crack();
   SolidConfig r = c;
   r.fracture.release_transits = 2;
   Solver at_once(c), released(r);

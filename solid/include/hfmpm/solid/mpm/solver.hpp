@@ -67,7 +67,9 @@ double growth_energy(const TipResult& tip, bool mode_one_only = false);
 
 // Whether a kinking tip's K's can set its direction: they carry J within a
 // factor 10 either way, J / 10 <= (K_I^2 + K_II^2) / E' <= 10 J (growth.cpp;
-// docs/solid.md, "Growth"). Otherwise the tip waits.
+// docs/solid.md, "Growth"). Otherwise the tip waits. Where growth_energy
+// takes Irwin's form (a sharp kink in one material) the K's are the energy
+// and there is nothing to check.
 bool growth_direction_known(const TipResult& tip);
 
 class Solver {
