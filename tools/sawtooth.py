@@ -17,25 +17,15 @@ import argparse
 import math
 import sys
 
-from compare_runs import read_history
+from compare_runs import moving_mean, read_history
 
 
 def swing(t, y, start, end, window):
     """RMS and largest relative deviation of y from its centred moving mean."""
     devs = []
-    lo = hi = 0
-    total = 0.0
-    for i, ti in enumerate(t):
-        while hi < len(t) and t[hi] <= ti + window / 2:
-            total += y[hi]
-            hi += 1
-        while t[lo] < ti - window / 2:
-            total -= y[lo]
-            lo += 1
-        if start <= ti <= end:
-            trend = total / (hi - lo)
-            if trend != 0:
-                devs.append(y[i] / trend - 1)
+    for ti, yi, trend in zip(t, y, moving_mean(t, y, window)):
+        if start <= ti <= end and trend != 0:
+            devs.append(yi / trend - 1)
     if not devs:
         return None
     return math.sqrt(sum(d * d for d in devs) / len(devs)), max(abs(d) for d in devs), len(devs)
