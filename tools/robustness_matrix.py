@@ -57,7 +57,7 @@ def case(name, base, km, **changes):
 
 def cases():
     out = []
-    for km in (0.01, 0.1, 1, 10):
+    for km in (0.01, 0.1, 1, 2, 3, 10):  # 2 and 3 since 5 December (the transition's gap)
         out.append(case(f"lab-km{km:g}", LAB, km))
         out.append(case(f"field-km{km:g}", FIELD, km))
     # Km = 100 in the lab rock and fluid opens its crack by 45% of its length

@@ -293,6 +293,21 @@ TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
   EXPECT_THAT(too_wide, HasSubstr("of the expected half-length"));
   EXPECT_THAT(too_wide, HasSubstr("allowed: an opening of at most 20% of the half-length"));
   EXPECT_EQ(build_scene(toughness_problem()).derived.cautions.size(), 0u);  // 2% of its half-length
+  // Between the vertices, where built scenes at Km = 1.5-3 ran outside the
+  // matrix's bounds at 20 cells per half-length (Km 7.6 above has no caution;
+  // Km 1 and 5 passed); none once the problem asks for 40.
+  problem::Problem between = toughness_problem();
+  between.mutable_rock()->set_toughness_pa_sqrt_m(25e3 * 2 / 7.61);  // Km 2
+  const auto transition = build_scene(between).derived.cautions;
+  ASSERT_EQ(transition.size(), 1u);
+  EXPECT_THAT(transition[0], HasSubstr("Km = 2 lies between the vertices"));
+  between.mutable_accuracy()->set_cells_per_half_length(40);  // the remedy it names
+  EXPECT_TRUE(build_scene(between).derived.cautions.empty());
+  between.clear_accuracy();
+  between.mutable_rock()->set_toughness_pa_sqrt_m(25e3 * 1 / 7.61);  // Km 1
+  EXPECT_TRUE(build_scene(between).derived.cautions.empty());
+  between.mutable_rock()->set_toughness_pa_sqrt_m(25e3 * 5 / 7.61);  // Km 5
+  EXPECT_TRUE(build_scene(between).derived.cautions.empty());
 }
 
 // The same physics asked for finer resolution gets a finer cell in proportion.
