@@ -116,7 +116,13 @@ void check(const problem::Problem& p, Checks& c) {
     const auto& f = p.fluid();
     c.require(f.has_viscosity_pa_s(), "fluid.viscosity_pa_s");
     c.range("fluid.density_kg_m3", f.density_kg_m3(), f.density_kg_m3() > 0, "> 0 kg/m^3");
-    c.range("fluid.bulk_modulus_pa", f.bulk_modulus_pa(), f.bulk_modulus_pa() > 0, "> 0 Pa");
+    // The notch is filled at the confining stress, and no liquid's equation of
+    // state holds at pressures above its bulk modulus (the scene's own rule).
+    const double sigma_n = p.has_in_situ() ? p.in_situ().normal_to_crack_pa() : 0;
+    c.range("fluid.bulk_modulus_pa", f.bulk_modulus_pa(), f.bulk_modulus_pa() > 0 && f.bulk_modulus_pa() >= sigma_n,
+            "> 0 Pa and at least in_situ.normal_to_crack_pa (" + num(sigma_n) +
+                " Pa): the fluid fills the notch at that pressure, and Tait's equation of state does not hold "
+                "above the bulk modulus");
     c.range("fluid.viscosity_pa_s", f.viscosity_pa_s(), !f.has_viscosity_pa_s() || f.viscosity_pa_s() > 0,
             "> 0 Pa s (the builder sizes the run by the viscous and toughness vertices)");
   }

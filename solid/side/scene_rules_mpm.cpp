@@ -131,8 +131,9 @@ void check_mpm_solid(Checker& c, const scene::MpmSolid& m) {
       c.bad(k + "toughness_pa_sqrt_m", text(mat.toughness_pa_sqrt_m()),
             "unset: toughness_j_m2 is set (give one of them)");
     }
-    if (mat.has_toughness_j_m2()) c.positive(k + "toughness_j_m2", mat.toughness_j_m2(), "J/m^2");
-    if (mat.has_toughness_pa_sqrt_m()) c.positive(k + "toughness_pa_sqrt_m", mat.toughness_pa_sqrt_m(), "Pa m^0.5");
+    // 0: a material that holds no crack (the zero-toughness, viscosity-dominated limit).
+    if (mat.has_toughness_j_m2()) c.non_negative(k + "toughness_j_m2", mat.toughness_j_m2(), "J/m^2");
+    if (mat.has_toughness_pa_sqrt_m()) c.non_negative(k + "toughness_pa_sqrt_m", mat.toughness_pa_sqrt_m(), "Pa m^0.5");
   }
   if (m.regions_size() == 0) c.missing(key + "regions", "at least one region { material: .. rectangle { .. } }");
   for (int i = 0; i < m.regions_size(); ++i) {

@@ -318,6 +318,22 @@ TEST(SceneBuilder, AccuracySetsTheCell) {
   EXPECT_NEAR(coarse / fine, 2, 0.02);
 }
 
+// K_Ic = 0 is the M-vertex's own problem: a material that holds no crack, its
+// growth held back by the fluid alone (the zero-lag wait). Built and run, the lab
+// problem at K_Ic = 0 is within 2.1 / 4.0 / 2.1 / 4.9% (tip / front / opening /
+// pressure) of the M-vertex (docs/verification.md, "Between the vertices").
+TEST(SceneBuilder, ZeroToughnessIsTheViscosityDominatedLimit) {
+  problem::Problem p = toughness_problem();
+  p.mutable_rock()->set_toughness_pa_sqrt_m(0);
+  const BuiltScene built = build_scene(p);
+  EXPECT_EQ(built.derived.km, 0);
+  EXPECT_TRUE(built.derived.viscosity_dominated);
+  const scene::Scene s = checked(built);
+  EXPECT_EQ(s.solid().mpm().materials(0).toughness_pa_sqrt_m(), 0);
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::TIP_ASYMPTOTE_MATCHED);
+  EXPECT_TRUE(s.solid().mpm().fracture().has_max_lag_cells());
+}
+
 TEST(SceneBuilder, BadProblemsAreRefusedWithTheKeyAndWhatIsAllowed) {
   problem::Problem p = field_problem();
   p.mutable_rock()->set_poisson_ratio(0.5);
@@ -333,6 +349,13 @@ TEST(SceneBuilder, BadProblemsAreRefusedWithTheKeyAndWhatIsAllowed) {
   problem::Problem nan = field_problem();
   nan.mutable_rock()->set_youngs_modulus_pa(std::nan(""));
   EXPECT_THAT(refusal(nan), HasSubstr("rock.youngs_modulus_pa = nan is not allowed; allowed: > 0 Pa"));
+
+  // A fluid softer than the confining stress it fills the notch at: refused as
+  // a problem, not as the scene built from it.
+  problem::Problem soft = field_problem();
+  soft.mutable_fluid()->set_bulk_modulus_pa(1);
+  EXPECT_THAT(refusal(soft), HasSubstr("fluid.bulk_modulus_pa = 1 is not allowed; allowed: > 0 Pa and at least "
+                                       "in_situ.normal_to_crack_pa"));
 
   problem::Problem bad_name = field_problem();
   bad_name.set_name("../x");
