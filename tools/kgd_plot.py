@@ -53,23 +53,38 @@ import kgd_transition  # noqa: E402  (the solution between the vertices; its tab
 
 
 def vertices(E, nu, mu, Q, KIc, t):
+    """(M-vertex, K-vertex, Geertsma-de Klerk) at t; a vertex that does not exist (no viscosity:
+    no M-vertex and no Geertsma-de Klerk; no toughness: no K-vertex) is all NaN."""
     ep = E / (1 - nu * nu)
     mup = 12 * mu
     kp = math.sqrt(32 / math.pi) * KIc
-    m = (0.6152 * (ep * Q ** 3 * t ** 4 / mup) ** (1 / 6), 1.126 * (mup * Q ** 3 * t * t / ep) ** (1 / 6),
-         0.545 * (mup * ep * ep / t) ** (1 / 3))
-    k = (2 / math.pi ** (2 / 3) * (ep * Q * t / kp) ** (2 / 3), math.pi ** (-1 / 3) * (kp * kp * Q * t / ep ** 2) ** (1 / 3),
-         math.pi ** (1 / 3) / 8 * (kp ** 4 / (ep * Q * t)) ** (1 / 3))
+    nan = float("nan")
+    m = (nan, nan, nan)
+    if mup > 0:
+        m = (0.6152 * (ep * Q ** 3 * t ** 4 / mup) ** (1 / 6), 1.126 * (mup * Q ** 3 * t * t / ep) ** (1 / 6),
+             0.545 * (mup * ep * ep / t) ** (1 / 3))
+    k = (nan, nan, nan)
+    if kp > 0:
+        k = (2 / math.pi ** (2 / 3) * (ep * Q * t / kp) ** (2 / 3),
+             math.pi ** (-1 / 3) * (kp * kp * Q * t / ep ** 2) ** (1 / 3),
+             math.pi ** (1 / 3) / 8 * (kp ** 4 / (ep * Q * t)) ** (1 / 3))
     q = Q / 2
     G = E / (2 * (1 + nu))
-    gdk = (0.48 * (8 * G * q ** 3 / ((1 - nu) * mu)) ** (1 / 6) * t ** (2 / 3),
-           1.32 * (8 * (1 - nu) * mu * q ** 3 / G) ** (1 / 6) * t ** (1 / 3))
+    gdk = (nan, nan)
+    if mu > 0:
+        gdk = (0.48 * (8 * G * q ** 3 / ((1 - nu) * mu)) ** (1 / 6) * t ** (2 / 3),
+               1.32 * (8 * (1 - nu) * mu * q ** 3 / G) ** (1 / 6) * t ** (1 / 3))
     return m, k, gdk
 
 
 def km(E, nu, mu, Q, KIc):
-    ep = E / (1 - nu * nu)
-    return math.sqrt(32 / math.pi) * KIc / (ep ** 3 * 12 * mu * Q) ** 0.25
+    """Km = K' / (E'^3 mu' Q)^(1/4); infinite for an inviscid fluid in a tough rock."""
+    return kgd_transition.km_of(E, nu, mu, Q, KIc)
+
+
+def finite(values):
+    """The finite ones of values (a vertex that does not exist is NaN)."""
+    return [v for v in values if math.isfinite(v)]
 
 
 def read_history(path):
@@ -234,7 +249,7 @@ def main():
     ax[0, 0].set(xlabel="t (s)", ylabel="mouth opening (mm)")
     shown_w = ([1e3 * r[vertex if vertex is not None else 0][1] for r in refs] + [1e3 * r[2][1] for r in refs]
                + [1e3 * r[1] for r in trans])
-    ax[0, 0].set_ylim(0, 1.3 * max([1e3 * w for w in h["mouth_opening_m"]] + shown_w))
+    ax[0, 0].set_ylim(0, 1.3 * max(finite([1e3 * w for w in h["mouth_opening_m"]] + shown_w)))
     ax[0, 1].plot(t, h["crack_length_m"], "k.", ms=3, label="hfmpm (tip)")
     if front:
         ax[0, 1].plot(t, front, "c.", ms=2, label="hfmpm (fluid front)")
@@ -245,7 +260,7 @@ def main():
     ax[0, 1].set(xlabel="t (s)", ylabel="half-length (m)")
     # Scale to the run and the selected vertex (the other can be far off).
     shown = [r[vertex if vertex is not None else 0][0] for r in refs] + [r[2][0] for r in refs] + [r[0] for r in trans]
-    ax[0, 1].set_ylim(0, 1.3 * max(h["crack_length_m"] + shown))
+    ax[0, 1].set_ylim(0, 1.3 * max(finite(h["crack_length_m"] + shown)))
     ax[1, 0].plot(t, [1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"]], "k.", ms=3, label="hfmpm")
     ax[1, 0].plot(tt, [1e-3 * r[0][2] for r in refs], "b-", label="M-vertex")
     ax[1, 0].plot(tt, [1e-3 * r[1][2] for r in refs], "r--", label="K-vertex")
@@ -256,7 +271,7 @@ def main():
     net = [1e-3 * (p - a.sigma0) for p in h["inlet_pressure_pa"]]
     late = ([1e-3 * r[v][2] for x, r in zip(tt, refs) for v in (0, 1) if x >= 0.1 * tt[-1]]
             + [1e-3 * r[2] for x, r in zip(tt, trans) if x >= 0.1 * tt[-1]])
-    ax[1, 0].set_ylim(min(0.0, min(net)), 1.2 * max(net + late))
+    ax[1, 0].set_ylim(min(0.0, min(net)), 1.2 * max(finite(net + late)))
     try:
         import h5py
         with h5py.File(os.path.join(a.run, "solid.h5"), "r") as f:

@@ -535,12 +535,22 @@ def constants(km):
 
 
 def km_of(E, nu, mu, Q, KIc):
-    return math.sqrt(32 / math.pi) * KIc / ((E / (1 - nu * nu)) ** 3 * 12 * mu * Q) ** 0.25
+    """Km; infinite for an inviscid fluid (mu = 0) in a tough rock."""
+    scale = ((E / (1 - nu * nu)) ** 3 * 12 * mu * Q) ** 0.25
+    if scale == 0:
+        return math.inf if KIc > 0 else math.nan
+    return math.sqrt(32 / math.pi) * KIc / scale
 
 
 def transition(E, nu, mu, Q, KIc, t):
-    """(half-length, mouth opening, net inlet pressure) of the KGD at time t: kgd_plot.vertices()'s layout."""
+    """(half-length, mouth opening, net inlet pressure) of the KGD at time t: kgd_plot.vertices()'s layout.
+    An inviscid fluid (mu = 0) gives the K-vertex itself, in its own scaling (the viscosity
+    scaling is singular there)."""
     ep, mup = E / (1 - nu * nu), 12 * mu
+    if mu == 0:
+        kp = math.sqrt(32 / math.pi) * KIc
+        return (K_GAMMA * (ep * Q * t / kp) ** (2 / 3), K_OMEGA * (kp * kp * Q * t / ep ** 2) ** (1 / 3),
+                K_PI * (kp ** 4 / (ep * Q * t)) ** (1 / 3))
     gamma, om0, pi0 = constants(km_of(E, nu, mu, Q, KIc))
     return (gamma * (ep * Q ** 3 * t ** 4 / mup) ** (1 / 6), om0 * (mup * Q ** 3 * t * t / ep) ** (1 / 6),
             pi0 * (mup * ep * ep / t) ** (1 / 3))
@@ -671,6 +681,15 @@ def self_test():
     for name, v, c, t in zip(("gamma", "Omega(0)", "Pi(0)"), m, M_VERTEX, tab):
         check(rel(v, c) < 1e-3, f"Km = 0: {name} {v:.6f} within 0.1% of kgd_plot's M-vertex {c} ({(v - c) / c:+.3%})")
         check(rel(v, t) < 2e-5, f"Km = 0: {name} {v:.7f} within 2e-5 of the table's {t:.7f}")
+    # 1b. The inviscid fluid (mu = 0, Km infinite): transition() is the K-vertex in its own
+    #     scaling, and at a large finite Km the table's value tends to it (Km^-4 correction:
+    #     Km = 100 within 1e-4).
+    args = (1e7, 0.25, 0.0, 4.15e-4, 25e3, 3.0)
+    inviscid = transition(*args)
+    viscous = transition(1e7, 0.25, 1e-3 * (km_of(1e7, 0.25, 1e-3, 4.15e-4, 25e3) / 100) ** 4, 4.15e-4, 25e3, 3.0)
+    check(math.isinf(km_of(*args[:5])) and all(rel(v, k) < 1e-4 for v, k in zip(viscous, inviscid)),
+          f"mu = 0: Km infinite and the K-vertex {inviscid[0]:.5f} m / {inviscid[1]:.4e} m / {inviscid[2]:.1f} Pa, "
+          f"Km = 100 within 1e-4 of it ({viscous[0]:.5f} / {viscous[1]:.4e} / {viscous[2]:.1f})")
     # 2. K-vertex: Km = 100 (the first correction is Km^-4 = 1e-8 of it): 2e-4 at rho 8 (its
     #    discretization error is 7e-5 to 1.6e-4), 1e-5 after Richardson with rho 4 (order 2.7: 1e-6).
     r4, _ = solve(100.0, 4)
