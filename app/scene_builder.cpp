@@ -309,14 +309,14 @@ BuiltScene build_scene(const problem::Problem& p) {
   // narrow and 6-11% low in pressure against the transition solution. The
   // error is the resolution's: lab Km = 2 at 40 cells per half-length was
   // within 3.8 / 4.7 / 7.4% (7.1 / 6.9 / 10.8% at 20), at about ten times the
-  // cost (docs/verification.md, "Between the vertices").
+  // cost (docs/verification.md, "Built scenes between the vertices").
   if (d.km > 1.2 && d.km < 4 && l_end / d.cell < 39) {  // 39: the cell is rounded up
     d.cautions.push_back("Km = " + approx(d.km) +
                          " lies between the vertices, where built scenes at 20 cells per half-length and Km = "
                          "1.5-3 ran 3-9% long, 5-7% narrow and 6-11% low in net pressure against the transition "
                          "solution (Km = 1 and 5 within 5 / 5 / 10%); accuracy { cells_per_half_length: 40 } "
                          "halved the errors at Km = 2, at about ten times the cost (docs/verification.md, "
-                         "\"Between the vertices\")");
+                         "\"Built scenes between the vertices\")");
   }
   // The solid is small-strain linear elastic: a crack whose opening is a
   // sizeable part of its length (the strains near it are of that order) is
