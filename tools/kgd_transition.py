@@ -545,9 +545,11 @@ def km_of(E, nu, mu, Q, KIc):
 def transition(E, nu, mu, Q, KIc, t):
     """(half-length, mouth opening, net inlet pressure) of the KGD at time t: kgd_plot.vertices()'s layout.
     An inviscid fluid (mu = 0) gives the K-vertex itself, in its own scaling (the viscosity
-    scaling is singular there)."""
+    scaling is singular there); with no toughness either, NaN."""
     ep, mup = E / (1 - nu * nu), 12 * mu
     if mu == 0:
+        if not KIc > 0:  # neither viscosity nor toughness: no solution to compare with
+            return (math.nan, math.nan, math.nan)
         kp = math.sqrt(32 / math.pi) * KIc
         return (K_GAMMA * (ep * Q * t / kp) ** (2 / 3), K_OMEGA * (kp * kp * Q * t / ep ** 2) ** (1 / 3),
                 K_PI * (kp ** 4 / (ep * Q * t)) ** (1 / 3))

@@ -84,6 +84,34 @@ SolidConfig driven_edge_crack() {
   return config;
 }
 
+// Zero toughness (a material that holds no crack; the builder's K_Ic = 0, the
+// M-vertex's own problem): growth needs energy released, J > 0, not only J >=
+// J_Ic. Unloaded, the edge crack's J is exactly 0 and it must stay as it is
+// over three P-wave transits of the strip; under a load of a hundredth of the
+// 500 J/m^2 crack's onset load (J about 1e-4 of that crack's J_Ic) it grows as
+// soon as the load's wave has reached the tip and J turned positive.
+TEST(Propagation, ZeroToughnessGrowsOnlyWhereEnergyIsReleased) {
+  for (const double load : {0.0, 0.01}) {
+    auto config = driven_edge_crack();
+    const double sigma = load * config.tractions[0].normal(0) / 1.5;
+    config.tractions[0].normal = config.tractions[1].normal = TimeFunction::constant(sigma);
+    config.materials[0].toughness = 0;
+    Solver solid(config);
+    const std::size_t initial = solid.cracks()[0].size();
+    const double dt = solid.stable_dt();
+    const double transit = 2 * kDrivenH / kRock.p_wave_speed(kRock.density);
+    while (solid.time() < 3 * transit && solid.cracks()[0].size() == initial) solid.step(dt);
+    ASSERT_FALSE(solid.last_tips().empty());
+    if (load == 0) {
+      EXPECT_EQ(solid.last_tips().at(0).j, 0) << "no load, no energy";
+      EXPECT_EQ(solid.cracks()[0].size(), initial) << "an unloaded crack grew";
+    } else {
+      EXPECT_GT(solid.last_tips().at(0).j, 0);
+      EXPECT_GT(solid.cracks()[0].size(), initial) << "a loaded crack in a material with no toughness did not grow";
+    }
+  }
+}
+
 // fracture.max_lag_cells (the zero-lag closure of fluid-driven cracks): the
 // same edge crack under a load held at 1.5 sigma_c (J well above J_Ic) does
 // not grow while the fluid front reported on it lies more than max_lag_cells

@@ -320,7 +320,7 @@ TEST(SceneBuilder, AccuracySetsTheCell) {
 
 // K_Ic = 0 is the M-vertex's own problem: a material that holds no crack, its
 // growth held back by the fluid alone (the zero-lag wait). Built and run, the lab
-// problem at K_Ic = 0 is within 2.1 / 4.0 / 2.1 / 4.9% (tip / front / opening /
+// problem at K_Ic = 0 is within 2.1 / 4.1 / 2.1 / 5.0% (tip / front / opening /
 // pressure) of the M-vertex (docs/verification.md, "Built scenes between the vertices").
 TEST(SceneBuilder, ZeroToughnessIsTheViscosityDominatedLimit) {
   problem::Problem p = toughness_problem();

@@ -121,7 +121,10 @@ int Solver::propagate() {
       const double domain = config_.fracture.outer_cells * h;
       if (!straight && t_ - arrived_at < config_.fracture.front_settle_transits * domain / c_s) continue;
     }
-    if (!(growth_energy(tip, straight) >= tip.toughness)) continue;
+    // Energy must be released, not only reach the toughness: with a toughness
+    // of 0 (a material that holds no crack) an unloaded tip's J of 0 would.
+    const double released = growth_energy(tip, straight);
+    if (!(released >= tip.toughness && released > 0)) continue;
     if (!straight && !growth_direction_known(tip)) continue;  // its K's do not carry J: no direction yet
     const double kink = straight ? 0.0 : tip.kink;
     const double c = std::cos(kink), s = std::sin(kink);
