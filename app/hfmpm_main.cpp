@@ -78,7 +78,9 @@ options:
   --restart DIR        run, coupler: continue the run in DIR from its last complete checkpoint
   --quiet              no progress line
   --help, -h           this text (also after a command: hfmpm run --help)
-exit status: 0 success, 1 run failed, 2 bad scene or command line,
+exit status: 0 success, 1 run failed, 2 bad scene or command line, 3 stopped
+  before its end time by the physics (a crack reached the body's edge; run.json
+  "stopped" with the reason, outputs kept),
   128 + N stopped by signal N (130 SIGINT/Ctrl-C, 143 SIGTERM, 129 SIGHUP).
   The first SIGINT, SIGTERM or SIGHUP stops the run at its next control
   round: the sides shut down, outputs are flushed, run.json says
@@ -383,6 +385,16 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       std::cerr << "hfmpm: no output: the directory " << options.output_dir << " was not created\n";
     }
     return 1;
+  }
+  if (!summary.warnings.empty()) {
+    std::cerr << "hfmpm: the run passed through " << summary.warnings.size()
+              << " state(s) its answer must be read with (run.json \"warnings\"):\n";
+    for (const auto& w : summary.warnings) std::cerr << "hfmpm:   " << w.substr(0, w.find(':')) << "\n";
+  }
+  if (!summary.stopped.empty()) {
+    std::cerr << "hfmpm: stopped at t = " << summary.t << " s: " << summary.stopped << "\n"
+              << "hfmpm: output written so far is in " << options.output_dir << " (run.json: \"stopped\")\n";
+    return 3;
   }
   std::cout << std::setprecision(4) << "hfmpm: done: " << summary.steps << " steps to t = " << summary.t << " s in "
             << summary.wall_s << " s wall (" << static_cast<double>(summary.steps) / summary.stepping_wall_s

@@ -34,6 +34,15 @@ Vertex k_vertex(double e_prime, double toughness, double total_rate, double t);
 double toughness_number(double e_prime, double viscosity, double total_rate, double toughness);
 
 // What the builder derived (also written into the scene's comments).
+// The problem's in-situ stress (compressive magnitudes, Pa) in the grid's
+// axes, and its normal, along and shear parts on the notch's plane.
+struct NotchStresses {
+  double xx = 0, yy = 0, xy = 0;  // sigma_xy of the compressive tensor (tension-positive xy is -xy)
+  double normal = 0, along = 0, shear = 0;
+  double minimum = 0;  // the smaller principal stress
+};
+NotchStresses notch_stresses(const problem::Problem& p);
+
 struct Derived {
   double e_prime = 0, km = 0;
   bool viscosity_dominated = true;  // Km < 1: the M-vertex's checks and settings

@@ -62,8 +62,15 @@ RunSummary Coupler::run() {
     step_loop(summary);
     stop_sides(false, "end of run");
     summary.ok = true;
-    manifest_.set("status", stopped_at_max_steps_ ? "stopped at time.max_steps" : "completed");
+    if (!done_reason_.empty()) {
+      summary.stopped = done_reason_;
+      manifest_.set("status", "stopped");
+      manifest_.set("stop_reason", done_reason_);
+    } else {
+      manifest_.set("status", stopped_at_max_steps_ ? "stopped at time.max_steps" : "completed");
+    }
     report_rest();
+    for (const auto& [code, text] : warnings_) summary.warnings.push_back(text);
   } catch (const RunInterrupted& interrupted) {
     // Asked to stop: the sides end as at the end of a run (their outputs
     // flushed and closed), and the manifest says where the run stopped.
@@ -119,6 +126,7 @@ RunSummary Coupler::run() {
   if (energy_) {
     manifest_.set_number("inlet_work_j", energy_->inlet_work());
     manifest_.set_number("initial_fill_energy_j", energy_->initial_energy());
+    manifest_.set_number("released_in_situ_energy_j", energy_->released_energy());
     manifest_.set_number("max_kinetic_energy_over_inlet_work", energy_->largest_ratio());
     manifest_.set_number("max_kinetic_energy_over_inlet_work_t_s", energy_->largest_ratio_time());
     // The fluid's pressure change at frozen crack width (docs/stability.md, "The stiff-fluid lag").
@@ -137,7 +145,7 @@ void Coupler::report_rest() {
   manifest_.set_number("solid_final_kinetic_over_strain_energy", rest_->ratio());
   if (const auto warning = rest_->warning()) {
     manifest_.set("warning", *warning);
-    log_("warning: " + *warning);
+    warn("coupler", "not-at-rest", *warning);
   }
 }
 
@@ -150,6 +158,10 @@ void Coupler::prepare() {
   manifest_.set("run_id", run_id_);
   manifest_.set("scene", options_.scene_path);
   manifest_.set("scene_name", scene_.name());
+  for (const auto& caution : scene_.cautions()) {
+    manifest_.append("cautions", caution);
+    log_("caution: " + caution);
+  }
   manifest_.set("status", "starting");
   // Who runs it, since when: a run.json left at "running" by a coupler that
   // was killed (kill -9, a second signal) names a process that no longer exists.

@@ -196,6 +196,17 @@ std::string check_step_count(const scene::Scene& scene, double t, double dt, dou
 
 }  // namespace
 
+// An end state found by a side (its notice) or by the coupler's own watch:
+// once per code, in run.json's "warnings" and the log (stderr).
+void Coupler::warn(const std::string& who, const std::string& code, const std::string& message) {
+  if (warnings_.count(code)) return;
+  const std::string text = code + " (" + who + ", t = " + std::to_string(t_) + " s): " + message.substr(0, 4000);
+  warnings_[code] = text;
+  manifest_.append("warnings", text);
+  manifest_.save();
+  log_("warning: " + text);
+}
+
 void Coupler::step_loop(RunSummary& summary) {
   History& history = *history_;
   const auto start = Clock::now();
@@ -208,6 +219,7 @@ void Coupler::step_loop(RunSummary& summary) {
   Schedule schedule;
   if (sides_[1].expected) {
     energy_ = std::make_unique<EnergyWatch>(scene_.coupling().energy_bound());
+    state_watch_ = std::make_unique<StateWatch>(end);
   } else {
     rest_ = std::make_unique<RestWatch>(end);
   }
@@ -306,6 +318,19 @@ void Coupler::step_loop(RunSummary& summary) {
       max_coupling_lag_t_ = t_;
     }
     const bool at_control = step_ % block == 0 || t_ >= end * (1 - 1e-12) || last_allowed;
+    for (auto& side : sides_) {
+      if (!side.expected) continue;
+      for (const auto& notice : side.report->notices()) warn(side.name, notice.code(), notice.message());
+      if (side.report->status() == protocol::StepReport::DONE && done_reason_.empty()) {
+        done_reason_ = side.report->done_reason().empty() ? "the " + side.name + " side has nothing more to do"
+                                                          : side.report->done_reason().substr(0, 2000);
+      }
+    }
+    if (state_watch_ && at_control) {
+      for (const auto& notice : state_watch_->update(t_, sides_[1].diagnostics)) {
+        warn("coupler", notice.code, notice.message);
+      }
+    }
     if (rest_ && at_control) rest_->update(t_, sides_[0].diagnostics);
     if (energy_ && at_control) {
       if (auto failure = energy_->update(t_, step_, sides_[0].diagnostics, sides_[1].diagnostics)) {
@@ -331,9 +356,14 @@ void Coupler::step_loop(RunSummary& summary) {
       log_.file_only("checkpoint " + checkpoint_dir + " complete (t = " + std::to_string(t_) + " s)");
     }
     progress_.update(t_, step_, seconds_since(start));
+    if (!done_reason_.empty()) {  // a side has nothing more to do: the run stops here, its rows kept
+      if (!output) history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+      log_("stopped at step " + std::to_string(step_) + " (t = " + std::to_string(t_) + " s): " + done_reason_);
+      break;
+    }
   }
   summary.stepping_wall_s = stepping_before_ + seconds_since(start);
-  if (t_ < end * (1 - 1e-12)) {
+  if (done_reason_.empty() && t_ < end * (1 - 1e-12)) {
     stopped_at_max_steps_ = true;
     log_("stopped at step " + std::to_string(step_) + " (time.max_steps = " + std::to_string(max_steps) +
          ", in whole exchange windows) before time.end_s");

@@ -6,6 +6,7 @@
 
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/energy_watch.hpp"
+#include "hfmpm/coupling/state_watch.hpp"
 
 #include <unistd.h>
 
@@ -204,6 +205,11 @@ class Coupler {
   std::uint64_t heartbeats_sent_ = 0;
   std::unique_ptr<EnergyWatch> energy_;
   std::unique_ptr<RestWatch> rest_;  // dry runs: is the solid at rest at the end?
+  std::unique_ptr<StateWatch> state_watch_;  // coupled runs: the fluid's end states
+  // The end-state warnings so far, by code (run.json "warnings"; docs/stability.md).
+  std::map<std::string, std::string> warnings_;
+  void warn(const std::string& who, const std::string& code, const std::string& message);
+  std::string done_reason_;  // a side said DONE: why (the run stops there)
   double t_ = 0;
 };
 

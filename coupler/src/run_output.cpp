@@ -55,6 +55,14 @@ std::string Manifest::quoted(const std::string& value) {
   return out + "\"";
 }
 
+void Manifest::append(const std::string& key, const std::string& value) {
+  auto& list = lists_[key];
+  list.push_back(quoted(value));
+  std::string json = "[";
+  for (std::size_t i = 0; i < list.size(); ++i) json += (i ? ",\n    " : "\n    ") + list[i];
+  fields_[key] = json + "\n  ]";
+}
+
 void Manifest::save() const {
   // Write then rename, so a reader never sees half a file.
   const std::string tmp = path_ + ".tmp";

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "hfmpm/exchange.hpp"
 
@@ -29,12 +30,15 @@ class Manifest {
   explicit Manifest(std::string path) : path_(std::move(path)) {}
   void set(const std::string& key, const std::string& value) { fields_[key] = quoted(value); }
   void set_number(const std::string& key, double value);
+  // Appends a string to the list `key` (a JSON array).
+  void append(const std::string& key, const std::string& value);
   void save() const;
 
  private:
   static std::string quoted(const std::string& value);
   std::string path_;
   std::map<std::string, std::string> fields_;
+  std::map<std::string, std::vector<std::string>> lists_;
 };
 
 // Log lines to stderr and to the run's coupler.log.

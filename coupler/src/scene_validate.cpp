@@ -166,6 +166,16 @@ void check_step_count(Checker& c, const scene::Scene& s, const SceneRules& rules
 std::vector<SceneProblem> validate(const scene::Scene& s, const SceneRules& rules) {
   Checker c;
   check_name(c, s);
+  // Cautions are text for run.json and the log: a few lines of bounded length.
+  if (s.cautions_size() > 20) {
+    c.bad("cautions", std::to_string(s.cautions_size()) + " entries", "at most 20");
+  }
+  for (int i = 0; i < s.cautions_size(); ++i) {
+    if (s.cautions(i).size() > 2000) {
+      c.bad("cautions[" + std::to_string(i) + "]", std::to_string(s.cautions(i).size()) + " characters",
+            "at most 2000");
+    }
+  }
   check_time(c, s);
   check_checkpoints(c, s, rules);
   check_coupling(c, s.coupling());

@@ -253,6 +253,7 @@ void to_proto(const SideDiagnostics& d, protocol::Diagnostics* out) {
   out->set_fluid_particles(d.fluid_particles);
   out->set_coupling_lag(d.coupling_lag);
   out->set_strain_energy(d.strain_energy);
+  out->set_released_energy(d.released_energy);
 }
 
 SideDiagnostics from_proto(const protocol::Diagnostics& d) {
@@ -269,6 +270,7 @@ SideDiagnostics from_proto(const protocol::Diagnostics& d) {
   out.fluid_particles = d.fluid_particles();
   out.coupling_lag = d.coupling_lag();
   out.strain_energy = d.strain_energy();
+  out.released_energy = d.released_energy();
   return out;
 }
 

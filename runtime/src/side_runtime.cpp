@@ -13,6 +13,7 @@
 #include <limits>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 
 #include "exchange_log.hpp"
@@ -336,8 +337,16 @@ class SideRuntime {
     report->set_t(t_);
     report->set_stable_dt(model_.stable_dt());
     report->set_stable_dt_limit(model_.stable_dt_limit());
-    report->set_status(protocol::StepReport::OK);
+    const std::string done = model_.done_reason();
+    report->set_status(done.empty() ? protocol::StepReport::OK : protocol::StepReport::DONE);
+    report->set_done_reason(done);
     proto::to_proto(model_.diagnostics(), report->mutable_diagnostics());
+    for (const auto& notice : model_.notices()) {
+      if (!notices_sent_.insert(notice.code).second) continue;
+      auto* out = report->add_notices();
+      out->set_code(notice.code);
+      out->set_message(notice.message);
+    }
     report->set_compute_s(compute_s);
     report->set_exchange_s(exchange_s);
     report->set_checkpoint_written(command.checkpoint());
@@ -455,6 +464,7 @@ class SideRuntime {
   microseconds spin_{0};
   std::optional<CouplingScheme> scheme_;  // from the Welcome: the order of steps, sends and waits
   double publish_compute_s_ = 0;          // s in model_.publish since the last StepReport
+  std::set<std::string> notices_sent_;  // codes already reported (each once per run)
   bool poison_next_frame_ = false;
   bool set_up_ = false;
   std::string output_dir_;  // where the model writes (checkpoints under it)

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <optional>
+#include <sstream>
 
 #include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/output/side_frames.hpp"
@@ -55,6 +57,9 @@ class MpmSolidSide final : public coupling::SideModel {
                                 : std::nullopt);
     }
     frames_.setup(scene.output().hdf5() ? output_dir + "/solid.h5" : std::string(), "hfmpm solid: " + scene.name());
+    if (scene.has_fluid() && scene.fluid().has_mpm()) film_ = scene.fluid().mpm().virtual_opening_m();
+    end_time_ = scene.time().end_s();
+    initial_strain_energy_ = solver_->strain_energy();
   }
   bool can_checkpoint() const override { return true; }
   void will_restart() override { frames_.will_restart(); }
@@ -85,6 +90,7 @@ class MpmSolidSide final : public coupling::SideModel {
       solver_->set_crack_pressure(c, std::vector<double>(solver_->cracks()[c].size(), p));
     }
     solver_->step(dt);
+    watch(dt);
   }
   void publish(protocol::DataFrame& frame) override {
     auto* state = frame.mutable_crack();
@@ -152,7 +158,24 @@ class MpmSolidSide final : public coupling::SideModel {
         d.crack_face_load += crack.face_pressure(k) * crack.tributary_length(k);
     }
     for (const auto& crack : solver_->cracks()) d.crack_particles += static_cast<std::uint32_t>(crack.size());
+    // The in-situ energy the cracks released: with the in-situ stress as
+    // reference, the work of its shear traction on the faces' slip; without,
+    // the fall of the particles' strain energy (which holds the in-situ stress).
+    d.released_energy = solver_->config().in_situ_reference
+                            ? std::max(0.0, solver_->in_situ_shear_work())
+                            : std::max(0.0, initial_strain_energy_ - d.strain_energy);
     return d;
+  }
+  std::vector<Notice> notices() const override { return notices_; }
+  std::string done_reason() const override {
+    const auto& hit = solver_->boundary_reached();
+    if (!hit) return {};
+    std::ostringstream out;
+    out << "the crack reached the boundary: crack " << hit->crack << "'s " << (hit->at_end ? "end" : "start")
+        << " tip at (" << hit->position.x() << ", " << hit->position.y() << ") m would grow to within a cell of "
+        << "the body's edge at t = " << hit->t << " s; the run stops there, its output kept (a larger "
+        << "solid.mpm.grid and regions hold a longer crack)";
+    return out.str();
   }
   void write_output(std::uint64_t /*frame*/, double t) override {
     output::FrameWriter* writer = frames_.writer();
@@ -207,6 +230,74 @@ class MpmSolidSide final : public coupling::SideModel {
   }
 
  private:
+  // The end-state watches (docs/stability.md, "When a run must not pass
+  // silently"), after every step; each raises its notice once.
+  void watch(double dt) {
+    const double t = solver_->time();
+    const auto& fracture = solver_->config().fracture;
+    // A tip far above its toughness that does not grow, for a fifth of the
+    // run's time and at least 100 growth checks. A viscosity-dominated tip
+    // carries more than its toughness and waits for the fluid between growth
+    // steps; a KGD grows by a step s in 1.5 t s / L, under a tenth of t for
+    // any crack longer than 4 steps.
+    if (const auto o = solver_->longest_overload();
+        o && o->duration > 0.2 * end_time_ && o->duration > 100.0 * fracture.check_interval * dt) {
+      std::ostringstream out;
+      out << "crack " << o->crack << "'s " << (o->at_end ? "end" : "start") << " tip has carried K = " << o->k_ratio
+          << " x K_Ic for " << o->duration << " s (since t = " << t - o->duration
+          << " s) without growing: a quasi-static crack grows once K reaches K_Ic, so the answer from then on "
+             "is not the physics'. What held it: the zero-lag wait for the fluid's front "
+             "(solid.mpm.fracture.max_lag_cells), the settling waits, or K's that do not carry J, so that no "
+             "direction is known (docs/solid.md, \"Growth\")";
+      raise("stalled-tip", out.str());
+    }
+    // Faces open beyond the fluid's film while every pressure the fluid puts
+    // on them is below the smallest in-situ normal stress on the crack: a
+    // state no equilibrium has.
+    for (std::size_t c = 0; c < solver_->cracks().size(); ++c) {
+      const auto& crack = solver_->cracks()[c];
+      if (open_below_since_.size() <= c) open_below_since_.resize(c + 1, -1);
+      double highest = 0, lowest_normal = std::numeric_limits<double>::infinity(), volume = 0, length = 0;
+      for (std::size_t k = 0; k < crack.size(); ++k) {
+        highest = std::max(highest, crack.face_pressure(k));
+        const Vec2 n = crack.normal(k);
+        lowest_normal = std::min(lowest_normal, -n.dot(mpm::traction(solver_->in_situ_stress(crack.plane()[k]), n)));
+        volume += crack.width(k) * crack.tributary_length(k);
+        length += crack.tributary_length(k);
+      }
+      const bool wet = crack.wetted_length() >= 0;
+      const double resolution = 1e-3 * solver_->config().grid.h;
+      const bool forbidden = wet && lowest_normal > 0 && highest < 0.95 * lowest_normal &&
+                             volume > (2 * film_ + resolution) * length;
+      double& since = open_below_since_[c];
+      if (!forbidden) {
+        since = -1;
+        continue;
+      }
+      if (since < 0) since = t;
+      if (t - since > 0.1 * end_time_ && t - since > 50 * dt) {
+        std::ostringstream out;
+        out << "crack " << c << " is open (mean opening " << volume / length << " m, beyond the fluid's film of "
+            << film_ << " m) while the highest pressure on its faces, " << highest
+            << " Pa, is below the smallest in-situ normal stress on it, " << lowest_normal << " Pa, since t = "
+            << since << " s: no equilibrium has that, so the faces are not following the fluid (check the "
+            << "crack's path and the fluid's front in solid.h5 and fluid.h5)";
+        raise("open-below-stress", out.str());
+      }
+    }
+  }
+  void raise(const std::string& code, const std::string& message) {
+    for (const auto& n : notices_) {
+      if (n.code == code) return;
+    }
+    notices_.push_back({code, message});
+  }
+  std::vector<Notice> notices_;
+  std::vector<double> open_below_since_;  // s, per crack; -1: not in that state
+  double film_ = 0;                       // m, the fluid's virtual opening
+  double end_time_ = 0;                   // s, the scene's time.end_s
+  double initial_strain_energy_ = 0;      // J/m
+
   static CrackGeometry geometry(const mpm::Crack& crack) {
     CrackGeometry g;
     g.crack_id = crack.id();
@@ -321,6 +412,7 @@ mpm::SolidConfig to_solid_config(const scene::MpmSolid& s) {
     mpm::CrackSpec spec;
     spec.start_is_tip = cr.start_is_tip();
     spec.end_is_tip = cr.end_is_tip();
+    spec.friction = cr.friction_coefficient();
     const double spacing = cr.has_spacing_m() ? cr.spacing_m() : h / 2;
     // Resample each polyline segment into pieces no longer than the spacing.
     spec.points.emplace_back(cr.x_m(0), cr.y_m(0));

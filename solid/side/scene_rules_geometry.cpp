@@ -226,6 +226,10 @@ void check_crack_geometry(Checker& c, const scene::MpmSolid& m) {
         bad = true;
       }
     }
+    if (!(cr.friction_coefficient() >= 0) || !std::isfinite(cr.friction_coefficient())) {
+      c.bad(k + ".friction_coefficient", std::to_string(cr.friction_coefficient()),
+            "a finite number >= 0 (0: frictionless faces; a rock joint's is typically 0.6)");
+    }
     if (!bad) usable[static_cast<std::size_t>(i)] = std::move(pts);
   }
   // Two cracks within a cell: a node carries at most two velocity fields

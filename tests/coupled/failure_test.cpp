@@ -90,7 +90,7 @@ TEST(Failure, SideWithAnotherSceneSchemaIsRejected) {
   const auto older = run_with("solid", {"--scene-schema-version", "0"});
   expect_clean_failure(older, "solid", "was built with scene schema version 0 (before scenes were versioned)", 0);
   const auto newer = run_with("fluid", {"--scene-schema-version", "99"});
-  expect_clean_failure(newer, "fluid", "was built with scene schema version 99; this coupler's scenes are version 9",
+  expect_clean_failure(newer, "fluid", "was built with scene schema version 99; this coupler's scenes are version 10",
                        0);
 }
 

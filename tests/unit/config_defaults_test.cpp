@@ -196,7 +196,8 @@ TEST(ConfigDefaults, SolidSceneWithEveryKeyOmittedHasTheSchemasDefaults) {
                       {{"spacing_m", [](const CrackSpec& k) { return (k.points.at(1) - k.points.at(0)).norm(); }},
                        {"start_is_tip", [](const CrackSpec& k) { return k.start_is_tip ? 1 : 0; }},
                        {"end_is_tip", [](const CrackSpec& k) { return k.end_is_tip ? 1 : 0; }},
-                       {"inlet_vertex", [](const CrackSpec& k) { return static_cast<double>(k.inlet); }}},
+                       {"inlet_vertex", [](const CrackSpec& k) { return static_cast<double>(k.inlet); }},
+                       {"friction_coefficient", [](const CrackSpec& k) { return k.friction; }}},
                       {{"spacing_m", s.cell_size_m() / 2}, {"inlet_vertex", -1}}},  // unset: half a cell; a mouth
       c.cracks.at(0));
 

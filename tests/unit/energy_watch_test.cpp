@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "hfmpm/coupling/energy_watch.hpp"
+#include "hfmpm/coupling/state_watch.hpp"
 
 namespace hfmpm::coupling {
 namespace {
@@ -52,10 +55,28 @@ TEST(EnergyWatch, FailsWhenTheKineticEnergyExceedsTheBoundAndSaysWhy) {
   const auto failure = watch.update(0.2, 40, solid_with(150), fluid_at(1e5, 1e-3, 2e-2));
   ASSERT_TRUE(failure);
   for (const char* part :
-       {"kinetic energy", "step 40", "t = 0.2 s", "coupling.energy_bound", "coupling.exchange_interval",
-        "fluid.mpm.bulk_modulus_pa", "in-situ shear", "a crack crossing another crack"}) {
+       {"kinetic energy", "step 40", "t = 0.2 s", "coupling.energy_bound", "coupling.scheme: IMPLICIT",
+        "coupling.exchange_interval: 1", "in-situ stress released"}) {
     EXPECT_NE(failure->find(part), std::string::npos) << part << " missing from: " << *failure;
   }
+}
+
+// The in-situ energy a crack's sliding released (the solid's
+// released_energy) is a source like the inlet's work: the kinetic energy that
+// fails above with 100.4 J/m of inlet work and fill passes with 60 J/m
+// released beside them, and fails again above the three together.
+TEST(EnergyWatch, CountsTheInSituEnergyTheFacesReleased) {
+  EnergyWatch watch(1.0);
+  watch.start(fluid_at(1e5, 0, 4e-6));
+  SideDiagnostics solid = solid_with(150);
+  solid.released_energy = 60;
+  EXPECT_FALSE(watch.update(0.1, 20, solid, fluid_at(1e5, 1e-3, 1e-3)));
+  EXPECT_NEAR(watch.largest_ratio(), 150 / 160.4, 1e-12);
+  EXPECT_DOUBLE_EQ(watch.released_energy(), 60);
+  solid.kinetic_energy = 170;
+  const auto failure = watch.update(0.2, 40, solid, fluid_at(1e5, 1e-3, 1e-3));
+  ASSERT_TRUE(failure);
+  EXPECT_NE(failure->find("60 J/m of in-situ stress released"), std::string::npos) << *failure;
 }
 
 // energy_bound 0: bookkeeping only, never a failure.
@@ -106,6 +127,60 @@ TEST(RestWatch, WarnsWhenTheSolidEndsMovingAndOnlyThen) {
   unmeasured.update(5, solid_energies(1e6, 1));
   EXPECT_FALSE(unmeasured.measured());
   EXPECT_FALSE(unmeasured.warning());
+}
+
+}  // namespace
+}  // namespace hfmpm::coupling
+
+namespace hfmpm::coupling {
+namespace {
+
+SideDiagnostics fluid_report(double inlet_pressure, double injected, double lag = 0) {
+  SideDiagnostics d;
+  d.inlet_pressure = inlet_pressure;
+  d.injected_volume = injected;
+  d.coupling_lag = lag;
+  return d;
+}
+
+// Rounds every 0.01 s of a 1 s run: a state is reported once it has held for
+// StateWatch::kRounds rounds and a tenth of the run (0.1 s), once per code.
+TEST(StateWatch, ZeroInletPressureUnderInjectionIsReportedOnceItLasts) {
+  StateWatch watch(1.0);
+  EXPECT_TRUE(watch.update(0, fluid_report(1e5, 0)).empty());
+  // A start-up spell of 0.05 s at zero (the water hammer of kgd-two-wing-ci): nothing.
+  for (int i = 1; i <= 5; ++i) EXPECT_TRUE(watch.update(0.01 * i, fluid_report(0, 1e-6 * i)).empty());
+  EXPECT_TRUE(watch.update(0.06, fluid_report(2e5, 6e-6)).empty());
+  // Zero from 0.07 s on while fluid goes in: reported at 0.17 s, once.
+  std::vector<std::string> codes;
+  double at = -1;
+  for (int i = 7; i <= 40; ++i) {
+    for (const auto& n : watch.update(0.01 * i, fluid_report(0, 1e-6 * i))) {
+      codes.push_back(n.code);
+      at = 0.01 * i;
+      EXPECT_NE(n.message.find("inlet pressure"), std::string::npos) << n.message;
+    }
+  }
+  ASSERT_EQ(codes, std::vector<std::string>{"zero-inlet-pressure"});
+  EXPECT_NEAR(at, 0.17, 1e-9);
+}
+
+TEST(StateWatch, NoInjectionNoZeroPressureReport) {
+  StateWatch watch(1.0);
+  for (int i = 0; i <= 50; ++i) EXPECT_TRUE(watch.update(0.01 * i, fluid_report(0, 1e-3)).empty());  // shut in
+}
+
+TEST(StateWatch, CouplingLagAboveTheLargestInletPressureIsReportedOnceItLasts) {
+  StateWatch watch(1.0);
+  EXPECT_TRUE(watch.update(0, fluid_report(1e5, 0)).empty());
+  // Spikes of 90 MPa for 0.03 s (kgd-two-wing-ci's first growth steps): nothing.
+  for (int i = 1; i <= 3; ++i) EXPECT_TRUE(watch.update(0.01 * i, fluid_report(1.3e5, 1e-6 * i, 9e7)).empty());
+  EXPECT_TRUE(watch.update(0.04, fluid_report(1.3e5, 4e-6, 1e3)).empty());
+  std::vector<std::string> codes;
+  for (int i = 5; i <= 40; ++i) {
+    for (const auto& n : watch.update(0.01 * i, fluid_report(1.2e5, 1e-6 * i, 1.2e6))) codes.push_back(n.code);
+  }
+  EXPECT_EQ(codes, std::vector<std::string>{"coupling-lag"});
 }
 
 }  // namespace

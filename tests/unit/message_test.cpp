@@ -278,6 +278,7 @@ TEST(Versions, SceneSchemaIsBumpedWithTheSchema) {
       {7, 2265630044900314741ull},   // fluid.mpm.affine_transfer
       {8, 1754681767318198518ull},   // cracks.inlet_vertex
       {9, 13498048890745661301ull},  // fracture.release_transits
+      {10, 4473893897642791083ull},  // cracks.friction_coefficient, cautions
   };
   ASSERT_TRUE(fingerprints.count(hfmpm::proto::kSceneSchemaVersion))
       << "no fingerprint recorded for scene schema version " << hfmpm::proto::kSceneSchemaVersion;

@@ -265,14 +265,76 @@ TEST(SceneBuilder, TransitionTakesTheClosureOfTheNearerVertex) {
   EXPECT_EQ(checked(build_scene(p)).fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);
 }
 
+// A notch at an angle: the stress tensor in the grid's axes, the edges'
+// tractions (normal and shear) that hold it, the inclined notch with both
+// wings, growth by maximum hoop stress, the friction of its faces, and a
+// caution (in the scene, for run.json) where the in-situ shear alone carries
+// the notch past its toughness.
+TEST(SceneBuilder, InclinedNotchUnderAnisotropicStress) {
+  problem::Problem p = toughness_problem();
+  p.mutable_injection()->set_both_wings(true);
+  p.mutable_in_situ()->Clear();
+  p.mutable_in_situ()->set_sigma_hmin_pa(1e5);
+  p.mutable_in_situ()->set_sigma_hmax_pa(1.5e5);
+  p.set_notch_azimuth_deg(30);
+  p.set_notch_friction_coefficient(0.6);
+  const NotchStresses st = notch_stresses(p);
+  EXPECT_NEAR(st.normal, 1.5e5 * 0.25 + 1e5 * 0.75, 1e-6);  // 112.5 kPa
+  EXPECT_NEAR(std::abs(st.shear), 5e4 * std::sin(std::numbers::pi / 6) * std::cos(std::numbers::pi / 6), 1e-6);
+  const BuiltScene built = build_scene(p);
+  const scene::Scene s = checked(built);
+  const auto& m = s.solid().mpm();
+  EXPECT_EQ(m.fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
+  ASSERT_EQ(m.cracks_size(), 1);
+  EXPECT_NEAR(m.cracks(0).y_m(2) / m.cracks(0).x_m(2), std::tan(std::numbers::pi / 6), 1e-5);
+  EXPECT_DOUBLE_EQ(m.cracks(0).friction_coefficient(), 0.6);
+  EXPECT_DOUBLE_EQ(m.regions(0).initial_stress().xx_pa(), -1.5e5);
+  EXPECT_DOUBLE_EQ(m.regions(0).initial_stress().yy_pa(), -1e5);
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().initial_fill().pressure_pa(), 1.125e5);
+  // SHmax at 30 degrees, the notch along x: the tensor has shear, the edges hold it.
+  p.set_notch_azimuth_deg(0);
+  p.mutable_in_situ()->set_sigma_hmax_azimuth_deg(30);
+  const scene::Scene rotated = checked(build_scene(p));
+  const auto& r = rotated.solid().mpm();
+  const double xy = -5e4 * std::sin(std::numbers::pi / 6) * std::cos(std::numbers::pi / 6);  // tension positive
+  EXPECT_NEAR(r.regions(0).initial_stress().xy_pa(), xy, 1e-6);
+  int sheared = 0;
+  for (const auto& t : r.tractions()) {
+    const double expected = (t.edge() == scene::LEFT || t.edge() == scene::RIGHT) ? xy : -xy;
+    ASSERT_TRUE(t.has_shear_pa()) << scene::Edge_Name(t.edge());
+    EXPECT_NEAR(t.shear_pa().constant(), expected, 1e-6) << scene::Edge_Name(t.edge());
+    ++sheared;
+  }
+  EXPECT_EQ(sheared, 4);
+  // The toughness problem's K_Ic of 25 kPa m^0.5 holds its notch against
+  // 21.7 kPa of shear; the issue's lab well (K_Ic 100 Pa m^0.5) does not.
+  EXPECT_TRUE(built.derived.cautions.empty());
+  p.mutable_rock()->set_toughness_pa_sqrt_m(100);
+  p.mutable_fluid()->set_viscosity_pa_s(1e-2);
+  const BuiltScene sheared_well = build_scene(p);
+  ASSERT_FALSE(sheared_well.derived.cautions.empty());
+  EXPECT_THAT(sheared_well.derived.cautions.back(), HasSubstr("grows in shear before the fluid opens it"));
+  const scene::Scene with = checked(sheared_well);
+  ASSERT_GE(with.cautions_size(), 1);
+  EXPECT_THAT(with.cautions(with.cautions_size() - 1), HasSubstr("grows in shear"));
+  // Refused: an angle without both wings, or with the aligned form of the stress.
+  problem::Problem one_wing = p;
+  one_wing.set_notch_azimuth_deg(30);
+  one_wing.mutable_injection()->set_both_wings(false);
+  EXPECT_THAT(refusal(one_wing), HasSubstr("needs injection { both_wings: true }"));
+  problem::Problem aligned_form = toughness_problem();
+  aligned_form.mutable_injection()->set_both_wings(true);
+  aligned_form.set_notch_azimuth_deg(30);
+  EXPECT_THAT(refusal(aligned_form), HasSubstr("needs the in-situ stress as in_situ { sigma_hmin_pa"));
+}
+
 TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
   EXPECT_TRUE(build_scene(field_problem()).derived.cautions.empty());  // 15 times
+  // A high confinement is no caution: problems at 73 to 870 times the net
+  // pressure ran within 5% of their vertex (issue 46's false alarms).
   problem::Problem deep = field_problem();
   deep.mutable_in_situ()->set_normal_to_crack_pa(2e7);  // 300 times
-  const BuiltScene built = build_scene(deep);
-  ASSERT_EQ(built.derived.cautions.size(), 1u);
-  EXPECT_THAT(built.derived.cautions[0], HasSubstr("the confining stress is 300 times the expected net pressure"));
-  EXPECT_THAT(built.text, HasSubstr("# caution: the confining stress is 300 times"));
+  EXPECT_TRUE(build_scene(deep).derived.cautions.empty());
   problem::Problem shallow = toughness_problem();
   shallow.mutable_in_situ()->set_normal_to_crack_pa(1e4);  // the K-vertex's 17.8 kPa against 10 kPa
   ASSERT_EQ(build_scene(shallow).derived.cautions.size(), 1u);

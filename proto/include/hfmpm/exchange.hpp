@@ -86,8 +86,16 @@ struct SideDiagnostics {
   double fluid_volume = 0;     // m^2
   double front_position = 0;   // m
   double coupling_lag = 0;     // Pa, the fluid's pressure change at frozen crack width over its last exchange window
+  double released_energy = 0;  // J/m, in-situ elastic energy released by the faces' slip (solid)
   std::uint32_t crack_particles = 0;
   std::uint32_t fluid_particles = 0;
+};
+
+// A state a side found that the physics forbids or that a run must not pass
+// silently (protocol Notice): a code, sent once per run, and its message.
+struct Notice {
+  std::string code;
+  std::string message;
 };
 
 // The protocol's crack-update rule (docs/protocol.md, CrackState), in one

@@ -45,6 +45,7 @@ void Crack::save(StateWriter& out) const {
   out.put("above", above_);
   out.put("below", below_);
   out.put("pressure", pressure_);
+  out.put("contact", contact_);
   out.put("stiffness", stiffness_);
   out.put("reference_width", reference_width_);
   out.put("wetted_length", wetted_length_);
@@ -66,6 +67,7 @@ void Crack::load(const StateReader& in) {
   expect_size(above_, ids_.size(), "crack above");
   expect_size(below_, ids_.size(), "crack below");
   in.get("pressure", pressure_);
+  in.get("contact", contact_);
   in.get("stiffness", stiffness_);
   in.get("reference_width", reference_width_);
   in.get("wetted_length", wetted_length_);
@@ -85,6 +87,17 @@ void Solver::save(StateWriter& out) const {
   out.put("steps", steps_);
   out.put("contacts", contacts_);
   out.put("feedback_alpha", feedback_alpha_);
+  out.put("in_situ_shear_work", in_situ_shear_work_);
+  {
+    std::vector<double> since, hit;
+    for (const auto& tips : overloaded_since_) since.insert(since.end(), tips.begin(), tips.end());
+    if (boundary_reached_) {
+      const auto& b = *boundary_reached_;
+      hit = {static_cast<double>(b.crack), b.at_end ? 1.0 : 0.0, b.position.x(), b.position.y(), b.t};
+    }
+    out.put("overloaded_since", since);
+    out.put("boundary_reached", hit);
+  }
   out.put("step_begun", static_cast<int>(step_begun_));
   out.put("transfer", transfer_);
   // Particles.
@@ -174,6 +187,18 @@ void Solver::load(const StateReader& in) {
   in.get("steps", steps_);
   in.get("contacts", contacts_);
   in.get("feedback_alpha", feedback_alpha_);
+  in.get("in_situ_shear_work", in_situ_shear_work_);
+  {
+    std::vector<double> since, hit;
+    in.get("overloaded_since", since);
+    in.get("boundary_reached", hit);
+    overloaded_since_.assign(since.size() / 2, {0, 0});
+    for (std::size_t c = 0; c < overloaded_since_.size(); ++c) overloaded_since_[c] = {since[2 * c], since[2 * c + 1]};
+    boundary_reached_.reset();
+    if (hit.size() == 5) {
+      boundary_reached_ = BoundaryHit{static_cast<std::size_t>(hit[0]), hit[1] != 0, Vec2(hit[2], hit[3]), hit[4]};
+    }
+  }
   int begun = 0;
   in.get("step_begun", begun);
   step_begun_ = begun != 0;

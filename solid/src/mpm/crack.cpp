@@ -17,8 +17,12 @@ Vec2 left_normal(const Vec2& a, const Vec2& b) {
 }  // namespace
 
 Crack::Crack(std::uint32_t id, const CrackSpec& spec)
-    : id_(id), start_is_tip_(spec.start_is_tip), end_is_tip_(spec.end_is_tip) {
+    : id_(id), start_is_tip_(spec.start_is_tip), end_is_tip_(spec.end_is_tip), friction_(spec.friction) {
   if (spec.points.size() < 2) throw std::invalid_argument("a crack needs at least 2 points");
+  if (!(spec.friction >= 0) || !std::isfinite(spec.friction)) {
+    throw std::invalid_argument("a crack's friction coefficient must be finite and >= 0; got " +
+                                std::to_string(spec.friction));
+  }
   for (const auto& p : spec.points) append(p);
   if (spec.inlet >= 0) {
     if (!start_is_tip_ || !end_is_tip_ || spec.inlet == 0 || static_cast<std::size_t>(spec.inlet) + 1 >= size()) {
@@ -46,6 +50,7 @@ void Crack::append(const Vec2& position, const Vec2& reference) {
   pressure_.push_back(0.0);
   stiffness_.push_back(0.0);
   reference_width_.push_back(0.0);
+  contact_.push_back(Vec2::Zero());
 }
 
 void Crack::prepend(const Vec2& position) { prepend(position, position); }
@@ -61,6 +66,7 @@ void Crack::prepend(const Vec2& position, const Vec2& reference) {
   to_front(pressure_);
   to_front(stiffness_);
   to_front(reference_width_);
+  to_front(contact_);
   shift_wetted((plane_[1] - plane_[0]).norm());  // arc lengths count from the new first particle
 }
 
@@ -90,6 +96,15 @@ double Crack::tributary_length(std::size_t k) const {
   if (k > 0) l += 0.5 * (plane_[k] - plane_[k - 1]).norm();
   if (k + 1 < plane_.size()) l += 0.5 * (plane_[k + 1] - plane_[k]).norm();
   return l;
+}
+
+void Crack::clear_contact() { std::fill(contact_.begin(), contact_.end(), Vec2::Zero()); }
+
+void Crack::finish_contact(double dt) {
+  for (std::size_t k = 0; k < size(); ++k) {
+    const double length = tributary_length(k);
+    contact_[k] = dt > 0 && length > 0 ? Vec2(contact_[k] / (dt * length)) : Vec2::Zero();
+  }
 }
 
 double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(normal(k))); }

@@ -409,6 +409,10 @@ Solver::TipSums Solver::face_work(const Crack& crack, const TipFrame& f, double 
     const Vec2 n_up(-t.y(), t.x());
     Vec2 load = 0.5 * (crack.face_pressure(a) + crack.face_pressure(b)) * n_up;
     load += traction(in_situ_stress(mid), n_up);
+    // Where the faces touch, their contact (and friction) carries part of it
+    // (the traction on the face n_up points to: the crack's face above at an
+    // end tip, the one below at a start tip).
+    load += (0.5 * f.up) * (crack.contact_traction()[a] + crack.contact_traction()[b]);
     const Vec2 load_f = f.rot * load, s_f = f.rot * t, n_f = f.rot * n_up;  // tip frame
     const auto ja = aux_jump(pa), jb = aux_jump(pb);
     if (q > 0) {

@@ -80,9 +80,19 @@ int Solver::propagate() {
   // checks).
   std::vector<double> lengths;
   for (const auto& crack : cracks_) lengths.push_back(arc_length(crack.plane()).back());
+  if (overloaded_since_.size() != cracks_.size()) overloaded_since_.resize(cracks_.size(), {kForever, kForever});
   for (const auto& tip : last_tips_) {
     const bool straight = config_.fracture.straight;
     double& grown_at = grown_at_[tip.crack][tip.at_end ? 1 : 0];
+    // Watch for a tip that carries far more than its toughness and does not
+    // grow (watch_overload below); a growth this check resets it.
+    double& overloaded_since = overloaded_since_[tip.crack][tip.at_end ? 1 : 0];
+    const double energy = growth_energy(tip, straight);
+    if (energy >= kOverload * tip.toughness && energy > 0) {
+      overloaded_since = std::min(overloaded_since, t_);
+    } else {
+      overloaded_since = kForever;
+    }
     if (config_.fracture.settle_transits > 0 && grown_at > -kForever) {
       const double length = lengths[tip.crack];
       const double c_s = std::sqrt(shear_[tip.material] / density_[tip.material]);
@@ -130,8 +140,12 @@ int Solver::propagate() {
     const double c = std::cos(kink), s = std::sin(kink);
     const Vec2 d(c * tip.direction.x() - s * tip.direction.y(), s * tip.direction.x() + c * tip.direction.y());
     const Vec2 next = tip.position + config_.fracture.growth_cells * h * d;
-    // Stop a cell short of the body's edge: the crack has run through.
-    if ((next.array() < (body_lo_.array() + h)).any() || (next.array() > (body_hi_.array() - h)).any()) continue;
+    // Stop a cell short of the body's edge: the crack has run through (the
+    // side reports it and the run stops, boundary_reached()).
+    if ((next.array() < (body_lo_.array() + h)).any() || (next.array() > (body_hi_.array() - h)).any()) {
+      if (!boundary_reached_) boundary_reached_ = BoundaryHit{tip.crack, tip.at_end, tip.position, t_};
+      continue;
+    }
     // The new particle's reference position (Crack::reference): the tip's,
     // plus the step less the mean displacement gradient of the particles
     // within a cell of it.
@@ -177,6 +191,7 @@ int Solver::propagate() {
                                                   config_.fracture.growth_cells * h};
     }
     grown_at = t_;
+    overloaded_since = kForever;
     front_arrived_at_[tip.crack][tip.at_end ? 1 : 0] = -kForever;
     ++added;
   }
@@ -185,6 +200,19 @@ int Solver::propagate() {
     reproject_strains(cut);
   }
   return added;
+}
+
+std::optional<Solver::Overload> Solver::longest_overload() const {
+  std::optional<Overload> worst;
+  for (const auto& tip : last_tips_) {
+    if (tip.crack >= overloaded_since_.size()) continue;
+    const double since = overloaded_since_[tip.crack][tip.at_end ? 1 : 0];
+    if (since == kForever) continue;
+    const double energy = growth_energy(tip, config_.fracture.straight);
+    const Overload o{tip.crack, tip.at_end, t_ - since, tip.toughness > 0 ? std::sqrt(energy / tip.toughness) : kForever};
+    if (!worst || o.duration > worst->duration) worst = o;
+  }
+  return worst;
 }
 
 // Feedback (Nose-Hoover) damping: d alpha / dt = (2 KE - 2 KE_target) / (M q).

@@ -219,7 +219,11 @@ void Solver::begin_step() {
     p2g<false>();
     edge_loads();
   } else {
-    for (auto& crack : cracks_) crack.prepare(3 * config_.grid.h, 1e-6 * config_.grid.h);
+    record_faces();
+    for (auto& crack : cracks_) {
+      crack.prepare(3 * config_.grid.h, 1e-6 * config_.grid.h);
+      crack.clear_contact();
+    }
     update_releases();
     p2g<true>();
     if (config_.fracture.surfaces_from_material) anchor_crack_surfaces();
@@ -241,8 +245,10 @@ void Solver::step(double dt) {
     grid_update(dt);
     if (config_.implicit_face_stiffness) implicit_face_stiffness(dt);
     contact(dt);  // on the updated momenta, forces made consistent
+    for (auto& crack : cracks_) crack.finish_contact(dt);
     g2p<true>(dt);
     move_crack_surfaces(dt);
+    account_in_situ_shear_work();
   }
   t_ += dt;
   ++steps_;

@@ -154,6 +154,37 @@ void Solver::crack_loads(bool in_situ, bool pressure) {
   }
 }
 
+// The work the in-situ shear traction on the faces has done over the step
+// (in_situ_reference): the faces carry sigma0 n (crack_loads), whose part
+// along the crack does work on the faces' slip. That is elastic energy of the
+// in-situ state the crack releases (frictionless faces under in-situ shear
+// slide at once), which the energy check must count as a source.
+void Solver::record_faces() {
+  if (!config_.in_situ_reference) return;
+  faces_before_.resize(cracks_.size());
+  for (std::size_t c = 0; c < cracks_.size(); ++c) {
+    const Crack& crack = cracks_[c];
+    auto& before = faces_before_[c];
+    before.resize(crack.size());
+    for (std::size_t k = 0; k < crack.size(); ++k) before[k] = crack.surface(1)[k] - crack.surface(-1)[k];
+  }
+}
+
+void Solver::account_in_situ_shear_work() {
+  if (!config_.in_situ_reference || faces_before_.size() != cracks_.size()) return;
+  for (std::size_t c = 0; c < cracks_.size(); ++c) {
+    const Crack& crack = cracks_[c];
+    if (faces_before_[c].size() != crack.size()) continue;
+    for (std::size_t k = 0; k < crack.size(); ++k) {
+      const Vec2 n = crack.normal(k);
+      const Vec2 t = traction(in_situ_stress(crack.plane()[k]), n);
+      const Vec2 shear = t - t.dot(n) * n;
+      const Vec2 moved = crack.surface(1)[k] - crack.surface(-1)[k] - faces_before_[c][k];
+      in_situ_shear_work_ += (crack.tributary_length(k) - unloaded_length(c, k)) * shear.dot(moved);
+    }
+  }
+}
+
 Solver::FaceResponse Solver::face_response(std::size_t c) const {
   if (!step_begun_) throw std::logic_error("Solver::face_response needs begin_step() first");
   const Crack& crack = cracks_.at(c);
@@ -343,7 +374,8 @@ void Solver::implicit_face_stiffness(double dt) {
 // Contact (Nairn 2003, section 2.3): where a node has both fields, the crack
 // surfaces there are in contact if the displacement-based opening along the
 // crack normal is not positive (to 1e-6 h) AND they approach; then the normal components of
-// the two fields' velocities are made equal (frictionless), conserving momentum.
+// the two fields' velocities are made equal, conserving momentum, and their
+// tangential ones as far as the crack's Coulomb friction allows.
 void Solver::contact(double dt) {
   const auto& g = config_.grid;
   const double contact_tolerance = 1e-6 * g.h;
@@ -394,7 +426,31 @@ void Solver::contact(double dt) {
     // switch its contact off (the faces would overlap, then chatter). The
     // 1e-6 h tolerance is far below any opening of interest.
     if (!(opening <= contact_tolerance && approach < 0)) continue;
-    const Vec2 dp = ((m0 * p1 - m1 * p0) / (m0 + m1)).dot(n_up) * n_up;  // to field 0
+    // The momentum to field 0 that would give both fields one velocity; its
+    // normal part (> 0: they approach) is the contact's, and of its
+    // tangential part Coulomb friction takes at most friction x that normal
+    // impulse (Nairn 2003, section 2.3): stick below, slide at the limit.
+    const Vec2 stick = (m0 * p1 - m1 * p0) / (m0 + m1);
+    const double normal_impulse = stick.dot(n_up);
+    Vec2 dp = normal_impulse * n_up;
+    if (const double mu = nearest->friction(); mu > 0) {
+      const Vec2 slide = stick - dp;
+      const double limit = mu * normal_impulse, magnitude = slide.norm();
+      dp += magnitude <= limit ? slide : Vec2((limit / magnitude) * slide);
+    }
+    // The faces' contact traction for J and K (Crack::contact_traction): the
+    // impulse on the face above, shared by the two crack particles of the
+    // nearer segment by where the node projects onto it. Only the step's own
+    // contact (dt > 0): the one on the extrapolated momenta corrects what the
+    // transfer left, not a load (counted, it made the faces' contact carry
+    // 15% more than the in-situ load that pressed them together).
+    if (dt > 0) {
+      const Vec2 ab = pl[seg + 1] - pl[seg];
+      const double along = std::clamp((x - pl[seg]).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+      const Vec2 on_above = field0_above ? dp : Vec2(-dp);
+      cracks_[nearest_c].add_contact_impulse(seg, (1 - along) * on_above);
+      cracks_[nearest_c].add_contact_impulse(seg + 1, along * on_above);
+    }
     if (dt > 0) {
       velocity_[0][u] += dp / m0;
       velocity_[1][u] -= dp / m1;

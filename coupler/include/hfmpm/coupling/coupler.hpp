@@ -69,6 +69,11 @@ struct RunSummary {
   double solid_compute_s = 0, fluid_compute_s = 0;
   double solid_exchange_s = 0, fluid_exchange_s = 0;
   bool sides_in_sequence = false;  // Gauss-Seidel: the fluid steps after the solid, not beside it
+  // ok and non-empty: a side had nothing more to do and the run stopped
+  // before its end time, e.g. "the crack reached the boundary: ..." (run.json "stopped").
+  std::string stopped;
+  // The end states the run passed through (run.json "warnings"), one per code.
+  std::vector<std::string> warnings;
   // stepping_wall_s minus the sides' compute time, per step: minus the slower
   // side's when they step side by side (Jacobi), minus both when in sequence.
   double overhead_per_step_us() const;

@@ -1,9 +1,12 @@
 // A run-time energy check for coupled runs: the solid's kinetic energy
-// against the energy the fluid can have given it, E = W_in + p0 V0: the work
+// against the energy the run can have given it, E = W_in + p0 V0 + W_r: the work
 // the inlet has done, W_in = integral of p_inlet dV_injected, plus the
 // initial fill's p0 V0 (its inlet pressure times its volume at the start, the
 // work it would do doubling its volume at that pressure; a generous scale for
-// its stored energy, p0^2 V0 / 2K). With loads that do no work of their own
+// its stored energy, p0^2 V0 / 2K), and the in-situ elastic energy the
+// cracks released by sliding, W_r (the solid's released_energy: an in-situ
+// stress with shear on a crack's plane does work on the faces' slip as soon as
+// nothing holds them, a real source). With loads that do no work of their own
 // (constant tractions, a confining stress held by them, as in every
 // hydraulic-fracture scene) the fluid is the only source of energy, so
 // KE <= E; dissipation (viscous flow, grid damping, PIC) keeps it well below
@@ -38,6 +41,7 @@ class EnergyWatch {
 
   double inlet_work() const { return work_; }        // J/m
   double initial_energy() const { return e0_; }      // J/m, p0 V0
+  double released_energy() const { return released_; }  // J/m, W_r at the last update
   double largest_ratio() const { return largest_; }  // max KE / (W_in + p0 V0)
   double largest_ratio_time() const { return largest_t_; }
 
@@ -61,6 +65,7 @@ class EnergyWatch {
   double p_ = 0, v_ = 0;  // last inlet pressure and injected volume
   double work_ = 0;
   double largest_ = 0, largest_t_ = 0;
+  double released_ = 0;
 };
 
 // The end-of-run check of a dry run (no fluid): is the solid at rest? Mean

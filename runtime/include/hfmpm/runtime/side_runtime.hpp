@@ -44,6 +44,14 @@ class SideModel {
   // Apply a frame from the peer; throws proto::ProtocolError if it is inconsistent.
   virtual void receive(const protocol::DataFrame& frame) = 0;
   virtual SideDiagnostics diagnostics() const = 0;
+  // Every notice raised so far (a state the physics forbids or a run must not
+  // pass silently, docs/protocol.md "Notices"); the runtime sends each code
+  // once, in the report of the command that first returns it.
+  virtual std::vector<Notice> notices() const { return {}; }
+  // Non-empty once the side has nothing more to do (a crack reached the
+  // body's edge): its reports then say DONE with this reason. The side still
+  // answers further commands.
+  virtual std::string done_reason() const { return {}; }
   virtual void write_output(std::uint64_t /*frame*/, double /*t*/) {}
   virtual void finish() {}
   // Checkpoints (docs/reliability.md, "Checkpoint and restart"). A model that

@@ -21,6 +21,11 @@ struct CrackSpec {
   // crack (a wellbore inside the body), or -1: the first particle, a mouth.
   // An inner particle of a crack whose two ends are tips.
   std::ptrdiff_t inlet = -1;
+  // Coulomb friction between the faces where they touch (contact): the
+  // tangential traction is at most friction x the normal compression. 0:
+  // frictionless. A friction of the faces, so it holds at any orientation of
+  // the crack to the grid (Solver::contact).
+  double friction = 0;
 };
 
 class Crack {
@@ -48,6 +53,15 @@ class Crack {
   // Pa, the pressure on the faces at the current width w:
   // max(0, p - stiffness (w - reference width)).
   double face_pressure(std::size_t k) const;
+  // Pa, the traction the faces' contact (and friction) put on the face above
+  // at each crack particle over the last step (0 where open): what the J and
+  // K face terms add to the face load where the faces touch (Solver::contact).
+  const std::vector<Vec2>& contact_traction() const { return contact_; }
+  // During a step: the contact's impulses on the face above, summed per crack
+  // particle (N s / m), then finish_contact turns them into tractions.
+  void clear_contact();
+  void add_contact_impulse(std::size_t k, const Vec2& impulse) { contact_[k] += impulse; }
+  void finish_contact(double dt);
   // Arc length from the first particle that the fluid has wetted (its front,
   // m), or negative when no fluid reports one; and where the wetted part
   // begins (0 at a mouth; the start-side front of a fluid entering at an
@@ -67,6 +81,7 @@ class Crack {
   // Its index now (the crack may have grown at its start), or 0 without one.
   std::size_t inlet_index() const;
   bool start_is_tip() const { return start_is_tip_; }
+  double friction() const { return friction_; }
   bool end_is_tip() const { return end_is_tip_; }
 
   // Unit normal at particle k: the mean of the left normals of its segments.
@@ -114,10 +129,12 @@ class Crack {
  private:
   std::uint32_t id_;
   bool start_is_tip_, end_is_tip_;
+  double friction_;
   std::vector<std::uint64_t> ids_;
   std::vector<Vec2> plane_, above_, below_, reference_;
   std::vector<double> pressure_;                     // Pa, on the faces, per crack particle
   std::vector<double> stiffness_, reference_width_;  // Pa/m and m, per crack particle
+  std::vector<Vec2> contact_;                        // Pa, the contact's traction on the face above
   double wetted_length_ = -1, wetted_start_ = 0;
   bool has_inlet_ = false;
   std::uint64_t inlet_id_ = 0;

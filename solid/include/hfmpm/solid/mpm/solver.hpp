@@ -15,6 +15,7 @@
 #include <array>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,6 +114,10 @@ class Solver {
   // J/m: elastic energy of the particles' stress, sum V sigma : C^-1 : sigma / 2
   // (of the change from the in-situ state with in_situ_reference).
   double strain_energy() const;
+  // J/m: the work the in-situ shear traction has done on the faces' slip
+  // since the start (in_situ_reference; 0 without): elastic energy of the
+  // in-situ state that the crack's sliding released (solver_cracks.cpp).
+  double in_situ_shear_work() const { return in_situ_shear_work_; }
   const SolidConfig& config() const { return config_; }
   const Grid& grid() const { return config_.grid; }
   Particles& particles() { return particles_; }
@@ -163,6 +168,27 @@ class Solver {
   // stress direction; returns the number of particles added. step() calls it
   // every check_interval steps when propagation is on.
   int propagate();
+  // The end-state watches of growth (docs/stability.md, "When a run must not
+  // pass silently"). A tip whose growth energy stays at or above kOverload x
+  // its toughness (K at least twice K_Ic) without growing: the one that has
+  // done so longest, with K / K_Ic (from the growth energy) now.
+  static constexpr double kOverload = 4;
+  struct Overload {
+    std::size_t crack = 0;
+    bool at_end = true;
+    double duration = 0;  // s, since its energy first reached kOverload x toughness
+    double k_ratio = 0;   // sqrt(growth energy / toughness)
+  };
+  std::optional<Overload> longest_overload() const;
+  // A tip that could not grow because its next step would come within a
+  // cell of the body's edge: the crack has run through the body.
+  struct BoundaryHit {
+    std::size_t crack = 0;
+    bool at_end = true;
+    Vec2 position = Vec2::Zero();
+    double t = 0;
+  };
+  const std::optional<BoundaryHit>& boundary_reached() const { return boundary_reached_; }
   // Feedback damping coefficient now, 1/s.
   double feedback_alpha() const { return feedback_alpha_; }
   // The region (later wins) and so material and in-situ stress at x; -1 if none.
@@ -234,6 +260,8 @@ class Solver {
   // Frictionless contact between the two fields of a node; dt = 0: on the
   // momenta after P2G; dt > 0: on the updated velocities (and accelerations).
   void contact(double dt);
+  void record_faces();
+  void account_in_situ_shear_work();
 
   // J and K at a tip, in named steps (fracture.cpp).
   struct TipFrame {
@@ -274,6 +302,10 @@ class Solver {
   // (anchor_crack_surfaces; empty without surfaces_from_material).
   std::vector<std::vector<std::array<Vec2, 2>>> surface_drift_;
   double feedback_alpha_ = 0;
+  double in_situ_shear_work_ = 0;
+  std::vector<std::array<double, 2>> overloaded_since_;  // s, per crack (start, end) tip; inf: not overloaded
+  std::optional<BoundaryHit> boundary_reached_;                    // J/m (in_situ_shear_work)
+  std::vector<std::vector<Vec2>> faces_before_;      // per crack particle, above - below at the step's start
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
   Particles particles_;
