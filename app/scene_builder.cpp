@@ -136,8 +136,9 @@ void check(const problem::Problem& p, Checks& c) {
     const auto& s = p.in_situ();
     const bool principal = s.has_sigma_hmin_pa() || s.has_sigma_hmax_pa() || s.has_sigma_hmax_azimuth_deg();
     if (principal && (s.has_normal_to_crack_pa() || s.has_along_crack_pa())) {
-      c.fail("in_situ gives both forms; allowed: normal_to_crack_pa (and along_crack_pa) for a notch along x, or "
-             "sigma_hmin_pa, sigma_hmax_pa and sigma_hmax_azimuth_deg");
+      c.fail(
+          "in_situ gives both forms; allowed: normal_to_crack_pa (and along_crack_pa) for a notch along x, or "
+          "sigma_hmin_pa, sigma_hmax_pa and sigma_hmax_azimuth_deg");
     } else if (principal) {
       c.require(s.has_sigma_hmin_pa(), "in_situ.sigma_hmin_pa");
       c.range("in_situ.sigma_hmin_pa", s.sigma_hmin_pa(), s.sigma_hmin_pa() >= 0, ">= 0 Pa (a compressive magnitude)");
@@ -165,11 +166,13 @@ void check(const problem::Problem& p, Checks& c) {
   }
   if (p.notch_azimuth_deg() != 0 && p.has_in_situ() && p.in_situ().has_normal_to_crack_pa()) {
     c.fail("notch_azimuth_deg = " + num(p.notch_azimuth_deg()) +
-           " needs the in-situ stress as in_situ { sigma_hmin_pa sigma_hmax_pa sigma_hmax_azimuth_deg } (normal_to_crack_pa "
+           " needs the in-situ stress as in_situ { sigma_hmin_pa sigma_hmax_pa sigma_hmax_azimuth_deg } "
+           "(normal_to_crack_pa "
            "is for a notch along x)");
   }
   c.range("notch_friction_coefficient", p.notch_friction_coefficient(),
-          p.notch_friction_coefficient() >= 0 && std::isfinite(p.notch_friction_coefficient()), ">= 0 (0: frictionless)");
+          p.notch_friction_coefficient() >= 0 && std::isfinite(p.notch_friction_coefficient()),
+          ">= 0 (0: frictionless)");
   if (p.has_fluid()) {
     const auto& f = p.fluid();
     c.require(f.has_viscosity_pa_s(), "fluid.viscosity_pa_s");
@@ -368,8 +371,8 @@ BuiltScene build_scene(const problem::Problem& p) {
   const double shear_k = std::abs(stresses.shear) * std::sqrt(std::numbers::pi * p.notch_m());
   if (shear_k > rock.toughness_pa_sqrt_m()) {
     d.cautions.push_back(
-        "the in-situ shear on the notch, " + approx(std::abs(stresses.shear)) + " Pa, alone gives K_II = " +
-        approx(shear_k) + " Pa m^0.5, " +
+        "the in-situ shear on the notch, " + approx(std::abs(stresses.shear)) +
+        " Pa, alone gives K_II = " + approx(shear_k) + " Pa m^0.5, " +
         (rock.toughness_pa_sqrt_m() > 0 ? approx(shear_k / rock.toughness_pa_sqrt_m()) + " times" : "above") +
         " K_Ic: the notch grows in shear before the fluid opens it, which the fluid-driven method is not verified "
         "for (such wells stopped or failed in measured runs; docs/scenes.md, \"An inclined well\"); a notch "
@@ -426,7 +429,7 @@ BuiltScene build_scene(const problem::Problem& p) {
   const std::string friction = p.notch_friction_coefficient() > 0
                                    ? " friction_coefficient: " + num(p.notch_friction_coefficient())
                                    : std::string();
-  const double wing_q = both ? q : 0.5 * q;      // m^2/s into the modelled crack
+  const double wing_q = both ? q : 0.5 * q;  // m^2/s into the modelled crack
   std::ostringstream s;
   // The regime names the vertex the run is compared with and the tip closure it uses.
   const std::string regime =
@@ -438,11 +441,10 @@ BuiltScene build_scene(const problem::Problem& p) {
     << (both ? "#   both wings: the whole body, no symmetry plane; the fluid enters at the notch's centre\n"
                "#   (a well inside the body; docs/fluid.md, \"Injection from inside the body\").\n"
              : "")
-    << (inclined || turning
-            ? "#   notch at " + approx(p.notch_azimuth_deg()) + " deg from x; in-situ stress on it " +
-                  approx(sigma_n) + " Pa normal, " + approx(std::abs(stresses.shear)) + " Pa shear" +
-                  (turning ? "; the tips grow in the direction of maximum hoop stress" : "") + ".\n"
-            : std::string())
+    << (inclined || turning ? "#   notch at " + approx(p.notch_azimuth_deg()) + " deg from x; in-situ stress on it " +
+                                  approx(sigma_n) + " Pa normal, " + approx(std::abs(stresses.shear)) + " Pa shear" +
+                                  (turning ? "; the tips grow in the direction of maximum hoop stress" : "") + ".\n"
+                            : std::string())
     << "#   E' = " << approx(d.e_prime) << " Pa, Km = " << approx(d.km) << ": " << regime << ".\n"
     << "#   Expected at the end (the " << (d.viscosity_dominated ? "M" : "K")
     << "-vertex, time less half the ramp): half-length " << approx(l_end) << " m,\n"
@@ -451,8 +453,8 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "#   cell " << approx(h) << " m: " << approx(l_end / h) << " cells along that half-length (accuracy "
     << approx(cells_per_l) << "), " << approx(p.notch_m() / h) << " along the notch (at least 2).\n"
     << "#   body " << approx(body_x) << " m x +-" << approx(body_y) << " m: " << approx(box)
-    << " final half-lengths beyond the crack; 2 x 2 particles per cell within 2 x +-"
-    << (turning || inclined ? 2 : 1) << " of\n"
+    << " final half-lengths beyond the crack; 2 x 2 particles per cell within 2 x +-" << (turning || inclined ? 2 : 1)
+    << " of\n"
     << "#   them around the crack, one beyond.\n"
     << "#   density_scaling " << approx(d.density_scaling) << ": the scaled P-wave (" << approx(scaled_c)
     << " m/s) crosses the final half-length in " << approx(100 * l_end / scaled_c / t_end)
@@ -497,8 +499,7 @@ BuiltScene build_scene(const problem::Problem& p) {
     }
     s << "cautions: \"" << escaped << "\"\n";
   }
-  s
-    << "description: \"KGD from physics: " << regime << ", Km = " << num(d.km) << "\"\n"
+  s << "description: \"KGD from physics: " << regime << ", Km = " << num(d.km) << "\"\n"
     << "time { end_s: " << num(t_end) << " safety_factor: 0.9 }\n"
     << "output { interval_s: " << num(t_end / 20) << " }\n"
     << "coupling { transport: IPC scheme: IMPLICIT exchange_interval: 1 control_interval: 20 }\n"

@@ -204,7 +204,7 @@ class Coupler {
   std::uint64_t step_ = 0;
   std::uint64_t heartbeats_sent_ = 0;
   std::unique_ptr<EnergyWatch> energy_;
-  std::unique_ptr<RestWatch> rest_;  // dry runs: is the solid at rest at the end?
+  std::unique_ptr<RestWatch> rest_;          // dry runs: is the solid at rest at the end?
   std::unique_ptr<StateWatch> state_watch_;  // coupled runs: the fluid's end states
   // The end-state warnings so far, by code (run.json "warnings"; docs/stability.md).
   std::map<std::string, std::string> warnings_;

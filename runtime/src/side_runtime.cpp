@@ -464,7 +464,7 @@ class SideRuntime {
   microseconds spin_{0};
   std::optional<CouplingScheme> scheme_;  // from the Welcome: the order of steps, sends and waits
   double publish_compute_s_ = 0;          // s in model_.publish since the last StepReport
-  std::set<std::string> notices_sent_;  // codes already reported (each once per run)
+  std::set<std::string> notices_sent_;    // codes already reported (each once per run)
   bool poison_next_frame_ = false;
   bool set_up_ = false;
   std::string output_dir_;  // where the model writes (checkpoints under it)

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -161,9 +161,8 @@ class MpmSolidSide final : public coupling::SideModel {
     // The in-situ energy the cracks released: with the in-situ stress as
     // reference, the work of its shear traction on the faces' slip; without,
     // the fall of the particles' strain energy (which holds the in-situ stress).
-    d.released_energy = solver_->config().in_situ_reference
-                            ? std::max(0.0, solver_->in_situ_shear_work())
-                            : std::max(0.0, initial_strain_energy_ - d.strain_energy);
+    d.released_energy = solver_->config().in_situ_reference ? std::max(0.0, solver_->in_situ_shear_work())
+                                                            : std::max(0.0, initial_strain_energy_ - d.strain_energy);
     return d;
   }
   std::vector<Notice> notices() const override { return notices_; }
@@ -267,8 +266,8 @@ class MpmSolidSide final : public coupling::SideModel {
       }
       const bool wet = crack.wetted_length() >= 0;
       const double resolution = 1e-3 * solver_->config().grid.h;
-      const bool forbidden = wet && lowest_normal > 0 && highest < 0.95 * lowest_normal &&
-                             volume > (2 * film_ + resolution) * length;
+      const bool forbidden =
+          wet && lowest_normal > 0 && highest < 0.95 * lowest_normal && volume > (2 * film_ + resolution) * length;
       double& since = open_below_since_[c];
       if (!forbidden) {
         since = -1;
@@ -279,8 +278,8 @@ class MpmSolidSide final : public coupling::SideModel {
         std::ostringstream out;
         out << "crack " << c << " is open (mean opening " << volume / length << " m, beyond the fluid's film of "
             << film_ << " m) while the highest pressure on its faces, " << highest
-            << " Pa, is below the smallest in-situ normal stress on it, " << lowest_normal << " Pa, since t = "
-            << since << " s: no equilibrium has that, so the faces are not following the fluid (check the "
+            << " Pa, is below the smallest in-situ normal stress on it, " << lowest_normal << " Pa, since t = " << since
+            << " s: no equilibrium has that, so the faces are not following the fluid (check the "
             << "crack's path and the fluid's front in solid.h5 and fluid.h5)";
         raise("open-below-stress", out.str());
       }

@@ -59,7 +59,11 @@ void expect_sane(const Case& c) {
     argv.push_back(s);
   }
   const auto result = run(argv, 600);
-  ASSERT_EQ(result.exit_code, 0) << c.name << ": " << result.err;
+  // A crack that runs to the body's edge stops the run there (exit 3): the
+  // long run's does at 11.4 s; its rows up to then are checked as any.
+  const bool at_edge =
+      result.exit_code == 3 && result.err.find("the crack reached the boundary") != std::string::npos;
+  ASSERT_TRUE(result.exit_code == 0 || at_edge) << c.name << ": " << result.err;
   const Csv h = read_csv(out + "/history.csv");
   const auto t = h.values("time_s"), p_in = h.values("inlet_pressure_pa"), injected = h.values("injected_volume_m2"),
              volume = h.values("fluid_volume_m2"), ke = h.values("kinetic_energy_j"), dt = h.values("dt_s");
@@ -267,7 +271,7 @@ TEST(Stability, PressureSpikeStopsTheRunWithADiagnosis) {
 // runaway check fired at step 59).
 TEST(Stability, WaterStiffFluidStopsTheRunWithADiagnosis) {
   expect_runaway_diagnosed("bulk_2GPa", gauss_seidel({}),
-                           {"energy is being created", "at step", "kinetic energy", "fluid.mpm.bulk_modulus_pa"});
+                           {"energy is being created", "at step", "kinetic energy", "coupling.scheme: IMPLICIT"});
 }
 
 // An exchange every 4 steps at h = 0.05 m and cfl 0.4 (kgd-viscosity; the

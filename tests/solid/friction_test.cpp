@@ -41,8 +41,8 @@ constexpr double kA = 1, kB = 10, kBeta = kPi / 6;
 constexpr double kSxx = -3e6, kSyy = -1e6;
 
 struct Slide {
-  double k1 = 0, k2 = 0;  // Pa m^0.5, worst of the two tips by |K_II|, as measured
-  double slip = 0;        // m, at the centre, |(above - below) . t|
+  double k1 = 0, k2 = 0;                   // Pa m^0.5, worst of the two tips by |K_II|, as measured
+  double slip = 0;                         // m, at the centre, |(above - below) . t|
   double normal_load = 0, shear_load = 0;  // N/m, the contact's tractions summed along the crack
 };
 

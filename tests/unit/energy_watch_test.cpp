@@ -54,9 +54,8 @@ TEST(EnergyWatch, FailsWhenTheKineticEnergyExceedsTheBoundAndSaysWhy) {
   EXPECT_NEAR(watch.largest_ratio(), 50 / 100.4, 1e-12);
   const auto failure = watch.update(0.2, 40, solid_with(150), fluid_at(1e5, 1e-3, 2e-2));
   ASSERT_TRUE(failure);
-  for (const char* part :
-       {"kinetic energy", "step 40", "t = 0.2 s", "coupling.energy_bound", "coupling.scheme: IMPLICIT",
-        "coupling.exchange_interval: 1", "in-situ stress released"}) {
+  for (const char* part : {"kinetic energy", "step 40", "t = 0.2 s", "coupling.energy_bound",
+                           "coupling.scheme: IMPLICIT", "coupling.exchange_interval: 1", "in-situ stress released"}) {
     EXPECT_NE(failure->find(part), std::string::npos) << part << " missing from: " << *failure;
   }
 }

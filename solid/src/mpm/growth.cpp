@@ -209,7 +209,8 @@ std::optional<Solver::Overload> Solver::longest_overload() const {
     const double since = overloaded_since_[tip.crack][tip.at_end ? 1 : 0];
     if (since == kForever) continue;
     const double energy = growth_energy(tip, config_.fracture.straight);
-    const Overload o{tip.crack, tip.at_end, t_ - since, tip.toughness > 0 ? std::sqrt(energy / tip.toughness) : kForever};
+    const Overload o{tip.crack, tip.at_end, t_ - since,
+                     tip.toughness > 0 ? std::sqrt(energy / tip.toughness) : kForever};
     if (!worst || o.duration > worst->duration) worst = o;
   }
   return worst;

@@ -39,10 +39,10 @@ class EnergyWatch {
   std::optional<std::string> update(double t, std::uint64_t step, const SideDiagnostics& solid,
                                     const SideDiagnostics& fluid);
 
-  double inlet_work() const { return work_; }        // J/m
-  double initial_energy() const { return e0_; }      // J/m, p0 V0
+  double inlet_work() const { return work_; }           // J/m
+  double initial_energy() const { return e0_; }         // J/m, p0 V0
   double released_energy() const { return released_; }  // J/m, W_r at the last update
-  double largest_ratio() const { return largest_; }  // max KE / (W_in + p0 V0)
+  double largest_ratio() const { return largest_; }     // max KE / (W_in + p0 V0)
   double largest_ratio_time() const { return largest_t_; }
 
   // The accumulators, for checkpoints.

@@ -39,8 +39,8 @@ class StateWatch {
   bool held(Held& h, bool now, double t);
   double end_time_;
   bool started_ = false;
-  double injected_ = 0;        // m^2 at the last round
-  double highest_inlet_ = 0;   // Pa, the largest inlet pressure so far
+  double injected_ = 0;       // m^2 at the last round
+  double highest_inlet_ = 0;  // Pa, the largest inlet pressure so far
   Held zero_inlet_, lag_;
 };
 

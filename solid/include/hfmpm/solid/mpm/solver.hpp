@@ -304,8 +304,8 @@ class Solver {
   double feedback_alpha_ = 0;
   double in_situ_shear_work_ = 0;
   std::vector<std::array<double, 2>> overloaded_since_;  // s, per crack (start, end) tip; inf: not overloaded
-  std::optional<BoundaryHit> boundary_reached_;                    // J/m (in_situ_shear_work)
-  std::vector<std::vector<Vec2>> faces_before_;      // per crack particle, above - below at the step's start
+  std::optional<BoundaryHit> boundary_reached_;          // J/m (in_situ_shear_work)
+  std::vector<std::vector<Vec2>> faces_before_;          // per crack particle, above - below at the step's start
   double total_mass_ = 0;
   Vec2 body_lo_ = Vec2::Zero(), body_hi_ = Vec2::Zero();  // bounding box of the particles' domains
   Particles particles_;
