@@ -61,8 +61,7 @@ void expect_sane(const Case& c) {
   const auto result = run(argv, 600);
   // A crack that runs to the body's edge stops the run there (exit 3): the
   // long run's does at 11.4 s; its rows up to then are checked as any.
-  const bool at_edge =
-      result.exit_code == 3 && result.err.find("the crack reached the boundary") != std::string::npos;
+  const bool at_edge = result.exit_code == 3 && result.err.find("the crack reached the boundary") != std::string::npos;
   ASSERT_TRUE(result.exit_code == 0 || at_edge) << c.name << ": " << result.err;
   const Csv h = read_csv(out + "/history.csv");
   const auto t = h.values("time_s"), p_in = h.values("inlet_pressure_pa"), injected = h.values("injected_volume_m2"),
