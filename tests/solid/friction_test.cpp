@@ -11,11 +11,11 @@
 //   slip at the centre 4 (1 - nu^2) tau_eff a / E;
 // where |tau| <= mu |sigma_n| they stick: K_II = 0 and no slip.
 // Checked at mu = 0 (0.866 MPa), 0.3 (0.416 MPa) and 0.6 (stuck), h = a/5
-// (HFMPM_FRICTION_CELLS=n for a/n; measured at a/5 and a/8):
-// - frictionless: K_II +2.8% (+1.3%), within the 5% the inclined crack is
+// (HFMPM_FRICTION_CELLS=n for a/n):
+// - frictionless: K_II +2.8%, within the 5% the inclined crack is
 //   verified to on this J domain (fracture_test.cpp);
 // - stuck (mu 0.6): no slip (1e-13 m against 3.7e-4 m frictionless) and
-//   |K_II| 9.5% (8.7%) of the frictionless one: the faces' contact carries
+//   |K_II| 9.5% of the frictionless one: the faces' contact carries
 //   95% of the in-situ load that presses them together; the tip cells,
 //   where the two sides share one field, carry the rest as a body would;
 // - sliding (mu 0.3): the nodal Coulomb law (Nairn's) carries 0.86 mu of
