@@ -61,7 +61,8 @@ points lie from the reference path of the same tip, in growth steps.
       the fluid-driven path, a row per step: t, p, each tip's position, K_I, K_II (in the tip's
       frame) and kink; --csv writes step, t_s, p_pa, tip, x_m, y_m, K_I, K_II, kink_deg,
       length_m (tip to tip along the crack; step k: the crack after k steps, as it grows);
-      --tips, hfmpm's tip points (tip, x, y) against it.
+      --tips, hfmpm's tip points (tip, x, y; or a run directory: its solid.h5's last frame)
+      against it.
 
 Units SI. Stress positive in tension inside the solver (sigma_H, sigma_h on the command line are
 compressive magnitudes); the MPM test's dry case: E = 10 GPa, nu = 0.25, a 2 m crack at 45 deg,
@@ -70,6 +71,7 @@ sigma_xx = -2 MPa, sigma_yy = -6 MPa.
 import argparse
 import csv
 import math
+import os
 import sys
 
 import numpy as np
@@ -674,6 +676,27 @@ def tip_paths(rows):
     return out
 
 
+def run_tips(run, a0, origin=(0.0, 0.0)):
+    """hfmpm's tip points from a run directory: the crack particles of crack 0 in the last frame of
+    RUN/solid.h5 farther than a0 from the well (origin), split at the particle nearest it into the
+    start and the end wing. Needs h5py (Debian's python3-h5py)."""
+    try:
+        import h5py
+    except ImportError:
+        sys.exit("curved_path: reading a run directory needs h5py (apt-get install python3-h5py)")
+    path = os.path.join(run, "solid.h5")
+    try:
+        with h5py.File(path, "r") as f:
+            frames = sorted(f["frames"].keys())
+            xy = np.asarray(f["frames"][frames[-1]]["crack0"]["positions"][()], float)
+    except (OSError, KeyError, IndexError) as e:
+        sys.exit(f"curved_path: {path}: no crack 0 in its frames ({e})")
+    r = np.hypot(xy[:, 0] - origin[0], xy[:, 1] - origin[1])
+    well = int(np.argmin(r))
+    out = {"start": xy[:well][r[:well] > a0 * (1 + 1e-6)], "end": xy[well + 1:][r[well + 1:] > a0 * (1 + 1e-6)]}
+    return {k: v for k, v in out.items() if len(v)}
+
+
 def read_tips(path):
     """hfmpm's tip points, {label: (n, 2) array}, from a CSV with a column tip and x, y (or x_m,
     y_m); a path file written with HFMPM_PATH_OUT gives its growth records."""
@@ -1220,7 +1243,8 @@ def run_fluid(args, ap):
             assert len(origin) == 2
         except (ValueError, AssertionError):
             ap.error(f"--tips-origin: x,y in m, got {args.tips_origin!r}")
-        got = path_distance(args.tips, rows, args.ds, origin)
+        tips = run_tips(args.tips, args.a0, origin) if os.path.isdir(args.tips) else args.tips
+        got = path_distance(tips, rows, args.ds, origin)
         for label, (tip, d) in got.items():
             print(f"hfmpm's tip {label!r}: at most {d:.3f} growth steps from the reference's {tip} tip")
         if args.max_distance is not None and any(not d <= args.max_distance for _, d in got.values()):
@@ -1268,8 +1292,9 @@ def main():
                     help="a crack that reaches K_Ic before the fluid drives it (no fluid in it, or a tip pressed "
                          "shut): stop with exit status 2 (default) or grow it anyway")
     fl.add_argument("--csv", help="write the rows: step, t_s, p_pa, tip, x_m, y_m, K_I, K_II, kink_deg, length_m")
-    fl.add_argument("--tips", help="hfmpm's tip points (CSV: tip, x, y or x_m, y_m; or a HFMPM_PATH_OUT file): their "
-                                   "largest distance from the reference path of the same tip, in growth steps")
+    fl.add_argument("--tips", help="hfmpm's tip points (CSV: tip, x, y or x_m, y_m; a HFMPM_PATH_OUT file; or a run "
+                                   "directory, its solid.h5's last frame): their largest distance from the reference "
+                                   "path of the same tip, in growth steps")
     fl.add_argument("--tips-origin", default="0,0", help="where hfmpm has the notch's centre, x,y in m (default 0,0)")
     args = ap.parse_args()
     if args.self_test:
