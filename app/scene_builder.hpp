@@ -42,6 +42,9 @@ struct NotchStresses {
   double minimum = 0;  // the smaller principal stress
 };
 NotchStresses notch_stresses(const problem::Problem& p);
+// What is wrong with a problem, one line each ("key = value is not allowed;
+// allowed: ..."); empty when build_scene can derive a scene from it.
+std::vector<std::string> problem_problems(const problem::Problem& p);
 
 struct Derived {
   double e_prime = 0, km = 0;

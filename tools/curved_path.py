@@ -697,14 +697,18 @@ def run_tips(run, a0, origin=(0.0, 0.0)):
     return {k: v for k, v in out.items() if len(v)}
 
 
+def open_or_exit(path):
+    """The file, opened for reading, or the tool stopped with a message naming it."""
+    try:
+        return open(path)
+    except OSError as e:
+        sys.exit(f"curved_path: cannot read {path}: {e.strerror}")
+
+
 def read_tips(path):
     """hfmpm's tip points, {label: (n, 2) array}, from a CSV with a column tip and x, y (or x_m,
     y_m); a path file written with HFMPM_PATH_OUT gives its growth records."""
-    try:
-        f = open(path)
-    except OSError as e:
-        sys.exit(f"curved_path: cannot read {path}: {e.strerror}")
-    with f:
+    with open_or_exit(path) as f:
         reader = csv.DictReader(f)
         names = reader.fieldnames or []
         cx = "x" if "x" in names else "x_m"
@@ -1009,11 +1013,7 @@ def read_run(path):
     A file that cannot be read, lacks a column or holds a value that is not a number stops the
     tool with a message naming the file, the line and what is expected."""
     growth, plane, h = [], [], None
-    try:
-        f = open(path)
-    except OSError as e:
-        sys.exit(f"curved_path: cannot read {path}: {e.strerror}")
-    with f:
+    with open_or_exit(path) as f:
         reader = csv.DictReader(f)
         missing = [c for c in COLUMNS if c not in (reader.fieldnames or [])]
         if missing:

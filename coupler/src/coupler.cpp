@@ -137,6 +137,17 @@ RunSummary Coupler::run() {
   return summary;
 }
 
+// An end state found by a side (its notice) or by the coupler's own watch:
+// once per code, in run.json's "warnings" and the log (stderr).
+void Coupler::warn(const std::string& who, const std::string& code, const std::string& message) {
+  if (warnings_.count(code)) return;
+  const std::string text = code + " (" + who + ", t = " + std::to_string(t_) + " s): " + message.substr(0, 4000);
+  warnings_[code] = text;
+  manifest_.append("warnings", text);
+  manifest_.save();
+  log_("warning: " + text);
+}
+
 // A dry run that ends with its solid still moving says so (RestWatch).
 void Coupler::report_rest() {
   if (!rest_ || !rest_->measured()) return;

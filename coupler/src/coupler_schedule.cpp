@@ -196,17 +196,6 @@ std::string check_step_count(const scene::Scene& scene, double t, double dt, dou
 
 }  // namespace
 
-// An end state found by a side (its notice) or by the coupler's own watch:
-// once per code, in run.json's "warnings" and the log (stderr).
-void Coupler::warn(const std::string& who, const std::string& code, const std::string& message) {
-  if (warnings_.count(code)) return;
-  const std::string text = code + " (" + who + ", t = " + std::to_string(t_) + " s): " + message.substr(0, 4000);
-  warnings_[code] = text;
-  manifest_.append("warnings", text);
-  manifest_.save();
-  log_("warning: " + text);
-}
-
 void Coupler::step_loop(RunSummary& summary) {
   History& history = *history_;
   const auto start = Clock::now();

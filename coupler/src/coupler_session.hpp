@@ -86,11 +86,6 @@ inline std::string random_id() {
   return out.str().substr(0, 12);
 }
 
-inline std::string host_name() {
-  char buffer[256] = {};
-  return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
-}
-
 // ISO 8601, UTC, to the second: 2026-12-03T02:41:07Z.
 inline std::string utc_now() {
   const std::time_t now = std::time(nullptr);

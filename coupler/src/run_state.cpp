@@ -135,10 +135,10 @@ RunState check_run_state(const std::string& run_dir, bool record) {
     state.pid = 0;
   }
   if (state.status != "starting" && state.status != "running") return state;  // a final status
-  if (state.host != detail::host_name()) {
+  if (state.host != host_name()) {
     state.coupler = RunState::Coupler::other_host;
     state.detail = "its coupler ran on " + (state.host.empty() ? std::string("an unnamed host") : state.host) +
-                   ", not on this host (" + detail::host_name() + "): cannot tell from here whether it still runs";
+                   ", not on this host (" + host_name() + "): cannot tell from here whether it still runs";
     return state;
   }
   const std::string pid = std::to_string(state.pid);

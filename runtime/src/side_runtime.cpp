@@ -40,11 +40,6 @@ struct CouplerLost {
 
 microseconds to_us(double seconds) { return microseconds(static_cast<std::int64_t>(seconds * 1e6)); }
 
-std::string host_name() {
-  char buffer[256] = {};
-  return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
-}
-
 class SideRuntime {
  public:
   SideRuntime(SideModel& model, const SideOptions& options)

@@ -1,11 +1,18 @@
 #include "hfmpm/runtime/transport.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <stdexcept>
 
 namespace hfmpm::coupling {
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+std::string host_name() {
+  char buffer[256] = {};
+  return gethostname(buffer, sizeof(buffer) - 1) == 0 ? std::string(buffer) : std::string("localhost");
+}
 
 void Link::send(const protocol::Envelope& envelope) {
   if (!send_bytes(proto::encode(envelope), true)) {

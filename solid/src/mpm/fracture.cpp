@@ -140,14 +140,6 @@ std::array<NearTipField, 2> williams(double r, double theta, double mu, double k
 
 }  // namespace
 
-int Solver::region_at(const Vec2& x) const {
-  int found = -1;
-  for (std::size_t r = 0; r < config_.regions.size(); ++r) {
-    if (config_.regions[r].contains(x)) found = static_cast<int>(r);  // later regions win
-  }
-  return found;
-}
-
 std::vector<TipResult> Solver::tips() const {
   std::vector<TipResult> out;
   for (std::size_t c = 0; c < cracks_.size(); ++c) {
@@ -177,22 +169,6 @@ Solver::TipFrame Solver::tip_frame(const Crack& crack, bool at_end) {
   f.rot.row(0) = f.e1.transpose();
   f.rot.row(1) = f.e2.transpose();
   return f;
-}
-
-// Material at a point: the region there, else the nearest particle's.
-std::size_t Solver::material_at(const Vec2& x) const {
-  const int r = region_at(x);
-  if (r >= 0) return static_cast<std::size_t>(config_.regions[static_cast<std::size_t>(r)].material);
-  std::size_t material = 0;
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t p = 0; p < particles_.size(); ++p) {
-    const double dist = (particles_.x[p] - x).squaredNorm();
-    if (dist < best) {
-      best = dist;
-      material = static_cast<std::size_t>(particles_.material[p]);
-    }
-  }
-  return material;
 }
 
 namespace {

@@ -362,6 +362,31 @@ std::vector<Voigt> Solver::total_stresses() const {
   return out;
 }
 
+// Where a point lies: the region there (the last that holds it), or -1.
+int Solver::region_at(const Vec2& x) const {
+  int found = -1;
+  for (std::size_t r = 0; r < config_.regions.size(); ++r) {
+    if (config_.regions[r].contains(x)) found = static_cast<int>(r);  // later regions win
+  }
+  return found;
+}
+
+// Material at a point: the region there, else the nearest particle's.
+std::size_t Solver::material_at(const Vec2& x) const {
+  const int r = region_at(x);
+  if (r >= 0) return static_cast<std::size_t>(config_.regions[static_cast<std::size_t>(r)].material);
+  std::size_t material = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < particles_.size(); ++p) {
+    const double dist = (particles_.x[p] - x).squaredNorm();
+    if (dist < best) {
+      best = dist;
+      material = static_cast<std::size_t>(particles_.material[p]);
+    }
+  }
+  return material;
+}
+
 Voigt Solver::in_situ_stress(const Vec2& x) const {
   int r = region_at(x);
   if (r < 0) {

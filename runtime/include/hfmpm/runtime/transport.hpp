@@ -122,4 +122,7 @@ std::string advertise(const std::string& bound_endpoint, const std::string& host
 // The host part of a tcp endpoint, "" otherwise.
 std::string tcp_host(const std::string& endpoint);
 
+// This machine's host name ("localhost" if it has none): Hello, run.json, advertised endpoints.
+std::string host_name();
+
 }  // namespace hfmpm::coupling
