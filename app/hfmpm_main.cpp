@@ -68,7 +68,10 @@ constexpr const char* kUsage = R"(usage:
 options:
   --out DIR            output directory (default: hfmpm-out/SCENE_NAME)
   --set KEY=VALUE      override one scene value, e.g. --set time.end_s=2
-                       --set coupling.transport=TCP; repeated fields take [a, b]
+                       --set coupling.transport=TCP; repeated fields take [a, b];
+                       one element of a list by index or name (docs/scenes.md):
+                       --set 'solid.mpm.cracks[0].x_m[1]=0.4'
+                       --set 'solid.mpm.materials[rock].youngs_modulus_pa=2e10'
   --transport T        same as --set coupling.transport=T (ipc, tcp or inproc)
   --keys FILE          coupler on tcp: its key file (coupler.keys from hfmpm keygen)
   --insecure-tcp       plain tcp without CURVE, for sides that cannot do it: anyone
@@ -302,8 +305,11 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   // The coupler's validation with each side's rules for its block: this
   // command links both sides, the coupler library neither.
   const coupling::SceneRules rules{solid::scene_rules(), fluid::scene_rules()};
-  const scene::Scene scene =
-      scene_path.empty() ? restart_point->state.scene() : coupling::load_scene(scene_path, rules, overrides);
+  // A scene file's unset method keys are derived from its physics (docs/scenes.md,
+  // "The derived method"); a checkpoint's own scene is continued with the method it ran.
+  std::vector<method::Setting> derived;
+  const scene::Scene scene = scene_path.empty() ? restart_point->state.scene()
+                                                : coupling::load_scene(scene_path, rules, overrides, &derived);
   if (restart_point && scene_path.empty()) {
     // The checkpoint's own scene, checked as a scene file is: a checkpoint this
     // program wrote holds a valid one, but a damaged or foreign one must be
@@ -347,7 +353,13 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       particles = static_cast<double>(solver.particles().size());
     }
     std::cout << "# " << scene_path << ": valid\n"
-              << coupling::describe(coupling::estimate_run_cost(filled, rules, particles)) << text;
+              << coupling::describe(coupling::estimate_run_cost(filled, rules, particles));
+    if (!derived.empty()) {
+      std::cout << "# The method derived from the scene's physics for the keys it leaves unset\n"
+                << "# (docs/scenes.md, \"The derived method\"; set a key to choose another value):\n"
+                << method::describe(derived, "#   ");
+    }
+    std::cout << text;
     return 0;
   }
   if (!options.keys_file.empty() && command != "coupler") {

@@ -7,7 +7,7 @@
 #include <numbers>
 #include <regex>
 
-#include "number_text.hpp"
+#include "hfmpm/coupling/number_text.hpp"
 #include "scene_builder.hpp"
 
 namespace hfmpm::app {

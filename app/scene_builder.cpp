@@ -1,11 +1,13 @@
 #include "scene_builder.hpp"
 
+#include <google/protobuf/text_format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <sstream>
 
-#include "number_text.hpp"
+#include "hfmpm/coupling/number_text.hpp"
 
 namespace hfmpm::app {
 namespace {
@@ -24,29 +26,6 @@ using text::significant;
 
 }  // namespace
 
-Vertex m_vertex(double e_prime, double viscosity, double total_rate, double t) {
-  const double mu = 12 * viscosity, q = total_rate;
-  Vertex v;
-  v.half_length = 0.6152 * std::pow(e_prime * q * q * q * t * t * t * t / mu, 1.0 / 6);
-  v.opening = 1.126 * std::pow(mu * q * q * q * t * t / e_prime, 1.0 / 6);
-  v.net_pressure = 0.545 * std::cbrt(mu * e_prime * e_prime / t);
-  return v;
-}
-
-Vertex k_vertex(double e_prime, double toughness, double total_rate, double t) {
-  const double k = std::sqrt(32 / std::numbers::pi) * toughness, q = total_rate;
-  Vertex v;
-  v.half_length = 2 / std::cbrt(std::numbers::pi * std::numbers::pi) * std::pow(e_prime * q * t / k, 2.0 / 3);
-  v.opening = std::cbrt(k * k * q * t / (std::numbers::pi * e_prime * e_prime));
-  v.net_pressure = std::cbrt(std::numbers::pi) / 8 * std::cbrt(k * k * k * k / (e_prime * q * t));
-  return v;
-}
-
-double toughness_number(double e_prime, double viscosity, double total_rate, double toughness) {
-  const double k = std::sqrt(32 / std::numbers::pi) * toughness;
-  return k / std::pow(e_prime * e_prime * e_prime * 12 * viscosity * total_rate, 0.25);
-}
-
 BuiltScene build_scene(const problem::Problem& p) {
   if (const auto problems = problem_problems(p); !problems.empty()) throw ProblemError(problems);
 
@@ -62,26 +41,32 @@ BuiltScene build_scene(const problem::Problem& p) {
   const bool turning = std::abs(stresses.shear) > 1e-9 * std::max(stresses.xx, stresses.yy);
   const double cells_per_l = p.accuracy().cells_per_half_length(), box = p.accuracy().box_half_lengths();
 
-  Derived d;
-  d.e_prime = e / (1 - nu * nu);
-  d.km = toughness_number(d.e_prime, fluid.viscosity_pa_s(), q, rock.toughness_pa_sqrt_m());
-  d.viscosity_dominated = d.km < 1;
-  // The closure of the nearer vertex, the transition (Km ~ 1 to 4) split at
-  // its middle: at Km = 1 the toughness closure ran the crack 10% long (the
-  // front's pressure taken to the tip ignores the viscous drop there) and the
-  // matched viscous closure was within 5.3 / 4.3 / 4.8%; at Km = 10 the
-  // matched closure ran the front 8% long and the pressure 13% high, the
-  // toughness closure within 1.3 / 3.0 / 4.7% (docs/verification.md, "A
-  // growth step without a jolt").
-  d.matched_closure = d.km < 2;
+  // The physics the method is sized by (hfmpm/coupling/method.hpp): the run
+  // derives the same from the scene written below.
+  method::Physics physics;
+  physics.youngs_modulus = e;
+  physics.poisson_ratio = nu;
+  physics.density = rock.density_kg_m3();
+  physics.toughness = rock.toughness_pa_sqrt_m();
+  physics.viscosity = fluid.viscosity_pa_s();
+  physics.total_rate = q;
+  physics.end_s = t_end;
   // A ramp over t_r injects the volume of a constant rate started t_r / 2 later.
-  const double t_eff = t_end - 0.5 * ramp;
-  const Vertex m = m_vertex(d.e_prime, fluid.viscosity_pa_s(), q, t_eff);
-  const Vertex k = k_vertex(d.e_prime, rock.toughness_pa_sqrt_m(), q, t_eff);
-  d.end = d.viscosity_dominated ? m : k;
-  // Viscosity and toughness both shorten the crack: it is no longer than either vertex.
-  const double l_end = std::min(m.half_length, rock.toughness_pa_sqrt_m() > 0 ? k.half_length : m.half_length);
-  d.end.half_length = l_end;
+  physics.effective_s = t_end - 0.5 * ramp;
+  physics.notch = p.notch_m();
+  physics.normal_stress = sigma_n;
+  physics.shear_stress = stresses.shear;
+  physics.minimum_stress = stresses.minimum;
+  physics.symmetric = !turning;
+  const method::Expected expected = method::expect(physics);
+
+  Derived d;
+  d.e_prime = expected.e_prime;
+  d.km = expected.km;
+  d.viscosity_dominated = expected.viscosity_dominated;
+  d.matched_closure = expected.matched_closure;
+  d.end = expected.end;
+  const double l_end = expected.end.half_length;
   if (!(l_end >= 1.5 * p.notch_m())) {
     throw ProblemError({"the fracture would hardly grow beyond its notch: expected half-length " + num(l_end) +
                         " m at duration_s = " + num(t_end) + " s against notch_m = " + num(p.notch_m()) +
@@ -101,55 +86,6 @@ BuiltScene build_scene(const problem::Problem& p) {
   const double reach = box * l_end;
   d.cells_x = static_cast<int>(std::ceil(reach / h));
   const double density = rock.density_kg_m3();
-  const double p_modulus = e * (1 - nu) / ((1 + nu) * (1 - 2 * nu));
-  const double c_p = std::sqrt(p_modulus / density), c_s = std::sqrt(e / (2 * (1 + nu)) / density);
-  // Quasi-static density scaling: the scaled P-wave crosses the final
-  // half-length in 0.5% of the injection time. With toughness, the settling
-  // wait after each growth step (2 shear transits of the crack per quarter
-  // cell) must not cap the tip below twice the vertex's final speed.
-  const double v_tip = 2.0 / 3.0 * l_end / t_end;
-  double scaling = std::pow(c_p * 0.005 * t_end / l_end, 2);
-  const double settle = d.viscosity_dominated ? 0.0 : 2.0;
-  // Growth step and wait, g cells. Viscosity-dominated, the tip waits for
-  // the fluid front and leads it by up to a wait and a step, 2 g h: keep that
-  // within 2.5% of the first length compared, three notch lengths. g is the
-  // largest of 1/4, 1/8, 1/16 that does (kgd-paper-field, 1 m cells, a 2 m
-  // notch: tip 9.5, 5.7, 4.0% worst from three notch lengths on at 1/4, 1/8,
-  // 1/16; the front, opening and pressure the same within 0.1 point from 1/8
-  // on; docs/verification.md, "The growth step on a coarse notch"). With
-  // toughness the settling wait scales as 1/g and a quarter stays.
-  double growth = 0.25;
-  if (settle == 0) {
-    while (growth > 1.0 / 16 && 2 * growth * h > 0.025 * 3 * p.notch_m()) growth /= 2;
-  }
-  d.growth_cells = growth;
-  if (settle > 0) {
-    const double c_s_needed = 2 * settle * l_end * v_tip / (growth * h);
-    scaling = std::min(scaling, std::pow(c_s / c_s_needed, 2));
-  }
-  d.density_scaling = significant(std::max(1.0, scaling), 2, true);
-  d.virtual_opening = significant(0.01 * d.end.opening, 2, false);
-  // Damping (mass-proportional, alpha): critical for the body's lowest mode,
-  // omega_1 = pi c / (2 B) (a quarter wave across the box B), but no more
-  // than delays the body behind a slowly rising load, by alpha / omega_1^2,
-  // 2% of the time t_3 at which the crack reaches three notch lengths (both
-  // vertices grow as t^(2/3)). Over-damped (5 /s at field scale), the body
-  // lagged the load and the net pressure ran 8% above the vertex.
-  const double scaled_c = c_p / std::sqrt(d.density_scaling);
-  const double omega = std::numbers::pi * scaled_c / (2 * d.cells_x * d.cell);
-  const double t_3 = t_eff * std::pow(std::min(1.0, 3 * p.notch_m() / l_end), 1.5);
-  double damping = std::min(2 * omega, 0.02 * omega * omega * t_3);
-  if (settle > 0) {
-    // With toughness each growth step rings the crack: the release of the
-    // cut runs to the mouth and back and dips the inlet pressure by up to 20%
-    // a shear transit later. Damp the crack's quarter-wave mode along its
-    // length at three notch lengths, omega_c = pi c_s / (2 L_3), critically,
-    // within the same 2% lag (docs/verification.md, "A growth step without a jolt").
-    const double l_3 = std::min(3 * p.notch_m(), l_end);
-    const double omega_c = std::numbers::pi * c_s / std::sqrt(d.density_scaling) / (2 * l_3);
-    damping = std::max(damping, std::min(2 * omega_c, 0.02 * omega_c * omega_c * t_3));
-  }
-  d.damping = significant(damping, 2, true);
 
   // Cautions from measured runs. With the net pressure above the confinement
   // the fluid lag is not small, which the zero-lag closures assume (the
@@ -231,14 +167,80 @@ BuiltScene build_scene(const problem::Problem& p) {
                                    ? " friction_coefficient: " + num(p.notch_friction_coefficient())
                                    : std::string();
   const double wing_q = both ? q : 0.5 * q;  // m^2/s into the modelled crack
-  std::ostringstream s;
   // The regime names the vertex the run is compared with and the tip closure it uses.
   const std::string regime =
       std::string(d.viscosity_dominated ? "viscosity-dominated (M-vertex)" : "toughness-dominated (K-vertex)") +
       (d.matched_closure ? ", viscous tip closure" : ", toughness tip closure");
+  std::ostringstream body;  // the scene: physics and geometry; the run derives the method
+  body << "name: \"" << p.name() << "\"\n";
+  // The cautions go with the scene: the run copies them to run.json and its log.
+  for (const auto& caution : d.cautions) {
+    std::string escaped;
+    for (const char ch : caution) {
+      if (ch == '"' || ch == '\\') escaped += '\\';
+      escaped += ch;
+    }
+    body << "cautions: \"" << escaped << "\"\n";
+  }
+  body << "description: \"KGD from physics: " << regime << ", Km = " << num(d.km) << "\"\n"
+       << "time { end_s: " << num(t_end) << " }\n"
+       << "output { interval_s: " << num(t_end / 20) << " }\n"
+       << "solid {\n  mpm {\n"
+       << "    grid { x_min_m: " << (both ? exact(-grid_x) : "0") << " y_min_m: " << exact(-grid_y)
+       << " x_max_m: " << exact(grid_x) << " y_max_m: " << exact(grid_y) << " }\n"
+       << "    cell_size_m: " << exact(h) << "\n"
+       << "    materials { name: \"rock\" youngs_modulus_pa: " << num(e) << " poisson_ratio: " << num(nu)
+       << " density_kg_m3: " << num(density) << " toughness_pa_sqrt_m: " << num(rock.toughness_pa_sqrt_m()) << " }\n";
+  const std::string stress = "initial_stress { xx_pa: " + exact(-stresses.xx) + " yy_pa: " + exact(-stresses.yy) +
+                             (stresses.xy != 0 ? " xy_pa: " + exact(-stresses.xy) : std::string()) + " }";
+  // Edge tractions hold the in-situ stress: normal sigma n, shear (counter-clockwise) sigma_xy on the left
+  // and right edges, -sigma_xy on the top and bottom (tension positive).
+  auto edge = [&](const char* name, double normal, double shear) {
+    return std::string("    tractions { edge: ") + name + " normal_pa { constant: " + exact(normal) + " }" +
+           (shear != 0 ? " shear_pa { constant: " + exact(shear) + " }" : std::string()) + " }\n";
+  };
+  body << "    regions { material: \"rock\" rectangle { x_min_m: " << (both ? exact(-body_x) : "0")
+       << " y_min_m: " << exact(-body_y) << " x_max_m: " << exact(body_x) << " y_max_m: " << exact(body_y)
+       << " }\n              " << stress << " particles_per_cell: 1 }\n"
+       << "    regions { material: \"rock\" rectangle { x_min_m: " << (both ? exact(-near_body_x) : "0")
+       << " y_min_m: " << exact(-near_body_y) << " x_max_m: " << exact(near_body_x)
+       << " y_max_m: " << exact(near_body_y) << " }\n              " << stress << " particles_per_cell: 2 }\n"
+       << (both ? edge("LEFT", -stresses.xx, -stresses.xy) : std::string("    constraints { symmetry_x_m: 0 }\n"))
+       << edge("RIGHT", -stresses.xx, -stresses.xy) << edge("TOP", -stresses.yy, stresses.xy)
+       << edge("BOTTOM", -stresses.yy, stresses.xy)
+       << (both ? "    silent_edges: [LEFT, RIGHT, TOP, BOTTOM]\n" : "    silent_edges: [RIGHT, TOP, BOTTOM]\n")
+       << (both ? "    cracks { x_m: [" + num(-notch_x) + ", 0, " + num(notch_x) + "] y_m: [" + num(-notch_y) + ", 0, " +
+                      num(notch_y) + "] start_is_tip: true end_is_tip: true inlet_vertex: 1" + friction +
+                      " }   # the well at (0, 0)\n"
+                : "    cracks { x_m: [0, " + num(p.notch_m()) + "] y_m: [0, 0] start_is_tip: false end_is_tip: true" +
+                      friction + " }\n")
+       << "  }\n}\n"
+       << "fluid {\n  mpm {\n"
+       << "    density_kg_m3: " << num(fluid.density_kg_m3()) << "\n"
+       << "    bulk_modulus_pa: " << num(fluid.bulk_modulus_pa()) << "\n"
+       << "    viscosity_pa_s: " << num(fluid.viscosity_pa_s()) << "\n"
+       << "    inlet { flow_rate_m2_s { "
+       << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(wing_q) + " }"
+                    : "constant: " + num(wing_q))
+       << (both ? " } }   # both wings: the total rate\n" : " } }   # one wing: half the total rate\n")
+       << "  }\n}\n";
+
+  // The method the run will derive from this scene, listed in its header.
+  scene::Scene built;
+  if (!google::protobuf::TextFormat::ParseFromString(body.str(), &built)) {
+    throw std::logic_error("hfmpm scene wrote a scene it cannot read");
+  }
+  const scene::Scene as_run = method::with_method(built, &d.method);
+  d.density_scaling = as_run.solid().mpm().density_scaling();
+  d.virtual_opening = as_run.fluid().mpm().virtual_opening_m();
+  d.damping = as_run.solid().mpm().damping().grid_alpha_per_s();
+  d.growth_cells = as_run.solid().mpm().fracture().growth_cells();
+
+  std::ostringstream s;
   s << "# Built by `hfmpm scene` from the problem '" << p.name() << "' (physics only; docs/scenes.md,\n"
-    << "# \"A scene from physics alone\"). Every numerical setting below is derived from the\n"
-    << "# physics, with its reason; any of them can still be overridden with --set.\n"
+    << "# \"A scene from physics alone\"). The geometry is sized from the physics; the numerical\n"
+    << "# method is not written: the run derives it from the same physics (listed below;\n"
+    << "# `hfmpm validate` prints it), and any key set here or with --set overrides it.\n"
     << (both ? "#   both wings: the whole body, no symmetry plane; the fluid enters at the notch's centre\n"
                "#   (a well inside the body; docs/fluid.md, \"Injection from inside the body\").\n"
              : "")
@@ -256,110 +258,14 @@ BuiltScene build_scene(const problem::Problem& p) {
     << "#   body " << approx(body_x) << " m x +-" << approx(body_y) << " m: " << approx(box)
     << " final half-lengths beyond the crack; 2 x 2 particles per cell within 2 x +-" << (turning || inclined ? 2 : 1)
     << " of\n"
-    << "#   them around the crack, one beyond.\n"
-    << "#   density_scaling " << approx(d.density_scaling) << ": the scaled P-wave (" << approx(scaled_c)
-    << " m/s) crosses the final half-length in " << approx(100 * l_end / scaled_c / t_end)
-    << "% of the injection time\n"
-    << "#   (target 0.5%"
-    << (settle > 0 ? "; with toughness, the settling wait may not cap the tip below 2x its speed" : "")
-    << "), and outruns the tip's final speed " << approx(scaled_c / v_tip) << "-fold.\n"
-    << "#   coupling IMPLICIT: the fluid's pressure is solved with the crack's opening, so any fluid\n"
-    << "#   (water too) runs at the solid's step, which the program chooses (safety 0.9).\n"
-    << "#   closure: "
-    << (d.matched_closure
-            ? "the dry tip zone carries the confining stress normal to the crack and the fluid\n"
-              "#   front meets the zero-toughness tip solution, its level matched to the fluid's pressures\n"
-              "#   two to four cells behind the front, one cell from the tip (zero lag); the faces' opening is\n"
-              "#   read from the material, which that closure needs; the tip waits for the fluid within\n"
-              "#   " +
-                  approx(growth) + " cell and grows by " + approx(growth) + " cell (it leads the front by up to " +
-                  approx(200 * growth * h / (3 * p.notch_m())) + "% of three notch lengths)" +
-                  std::string(settle > 0 ? ", and lets the opening follow, releasing the step over 2 transits" : "") +
-                  (d.viscosity_dominated ? "" : " (Km < 2: the closure of the nearer vertex)") + ".\n"
-            : "the fluid's front pressure reaches the tip (zero lag, uniform pressure);\n"
-              "#   the tip waits for the fluid within " +
-                  approx(growth) + " cell, grows by " + approx(growth) +
-                  " cell and lets the opening follow, releasing the step over 2 transits;\n"
-                  "#   the faces' opening is read from the material.\n")
-    << "#   damping " << approx(d.damping) << " /s: critical for the body's lowest mode (" << approx(omega) << " rad/s)"
-    << (settle > 0 ? " or, with toughness, for the crack's own quarter-wave mode at three notch lengths" : "")
-    << " or less, so that the body lags a rising load by at most 2% of the time the crack\n"
-    << "#   takes to three notch lengths (" << approx(t_3) << " s).\n"
-    << "#   virtual opening " << approx(d.virtual_opening) << " m: 1% of the expected final mouth opening.\n"
+    << "#   them around the crack, one beyond; silent edges, tractions holding the in-situ stress.\n"
     << "#   ramp " << approx(ramp) << " s" << (p.injection().has_ramp_s() ? "" : " (1% of the duration)")
-    << ": no water hammer at the start.\n";
+    << ": no water hammer at the start.\n"
+    << "# The derived method:\n"
+    << method::describe(d.method, "#   ");
   for (const auto& caution : d.cautions) s << "# caution: " << caution << "\n";
   if (p.has_description()) s << "# " << p.description() << "\n";
-  s << "name: \"" << p.name() << "\"\n";
-  // The cautions go with the scene: the run copies them to run.json and its log.
-  for (const auto& caution : d.cautions) {
-    std::string escaped;
-    for (const char ch : caution) {
-      if (ch == '"' || ch == '\\') escaped += '\\';
-      escaped += ch;
-    }
-    s << "cautions: \"" << escaped << "\"\n";
-  }
-  s << "description: \"KGD from physics: " << regime << ", Km = " << num(d.km) << "\"\n"
-    << "time { end_s: " << num(t_end) << " safety_factor: 0.9 }\n"
-    << "output { interval_s: " << num(t_end / 20) << " }\n"
-    << "coupling { transport: IPC scheme: IMPLICIT exchange_interval: 1 control_interval: 20 }\n"
-    << "solid {\n  mpm {\n"
-    << "    grid { x_min_m: " << (both ? exact(-grid_x) : "0") << " y_min_m: " << exact(-grid_y)
-    << " x_max_m: " << exact(grid_x) << " y_max_m: " << exact(grid_y) << " }\n"
-    << "    cell_size_m: " << exact(h) << "\n"
-    << "    materials { name: \"rock\" youngs_modulus_pa: " << num(e) << " poisson_ratio: " << num(nu)
-    << " density_kg_m3: " << num(density) << " toughness_pa_sqrt_m: " << num(rock.toughness_pa_sqrt_m()) << " }\n";
-  const std::string stress = "initial_stress { xx_pa: " + exact(-stresses.xx) + " yy_pa: " + exact(-stresses.yy) +
-                             (stresses.xy != 0 ? " xy_pa: " + exact(-stresses.xy) : std::string()) + " }";
-  // Edge tractions hold the in-situ stress: normal sigma n, shear (counter-clockwise) sigma_xy on the left
-  // and right edges, -sigma_xy on the top and bottom (tension positive).
-  auto edge = [&](const char* name, double normal, double shear) {
-    return std::string("    tractions { edge: ") + name + " normal_pa { constant: " + exact(normal) + " }" +
-           (shear != 0 ? " shear_pa { constant: " + exact(shear) + " }" : std::string()) + " }\n";
-  };
-  s << "    regions { material: \"rock\" rectangle { x_min_m: " << (both ? exact(-body_x) : "0")
-    << " y_min_m: " << exact(-body_y) << " x_max_m: " << exact(body_x) << " y_max_m: " << exact(body_y)
-    << " }\n              " << stress << " particles_per_cell: 1 }\n"
-    << "    regions { material: \"rock\" rectangle { x_min_m: " << (both ? exact(-near_body_x) : "0")
-    << " y_min_m: " << exact(-near_body_y) << " x_max_m: " << exact(near_body_x) << " y_max_m: " << exact(near_body_y)
-    << " }\n              " << stress << " particles_per_cell: 2 }\n"
-    << (both ? edge("LEFT", -stresses.xx, -stresses.xy) : std::string("    constraints { symmetry_x_m: 0 }\n"))
-    << edge("RIGHT", -stresses.xx, -stresses.xy) << edge("TOP", -stresses.yy, stresses.xy)
-    << edge("BOTTOM", -stresses.yy, stresses.xy)
-    << (both ? "    silent_edges: [LEFT, RIGHT, TOP, BOTTOM]\n" : "    silent_edges: [RIGHT, TOP, BOTTOM]\n")
-    << "    density_scaling: " << num(d.density_scaling) << "\n"
-    << "    in_situ_reference: true\n"
-    << "    damping { grid_alpha_per_s: " << num(d.damping) << " pic_fraction: 0.5 }\n"
-    << "    fracture { j_inner_cells: 1 j_outer_cells: 3 propagate: true growth_cells: " << num(growth)
-    << " check_interval: 2 direction: " << (turning ? "MAX_HOOP_STRESS" : "STRAIGHT")
-    << "\n               max_lag_cells: " << num(growth)
-    << (settle > 0 ? " settle_transits: 2 release_transits: 2" : "") << " surfaces_from_material: true"
-    << " }\n"
-    << (both ? "    cracks { x_m: [" + num(-notch_x) + ", 0, " + num(notch_x) + "] y_m: [" + num(-notch_y) + ", 0, " +
-                   num(notch_y) + "] start_is_tip: true end_is_tip: true inlet_vertex: 1" + friction +
-                   " }   # the well at (0, 0)\n"
-             : "    cracks { x_m: [0, " + num(p.notch_m()) + "] y_m: [0, 0] start_is_tip: false end_is_tip: true" +
-                   friction + " }\n")
-    << "  }\n}\n"
-    << "fluid {\n  mpm {\n"
-    << "    density_kg_m3: " << num(fluid.density_kg_m3()) << "\n"
-    << "    bulk_modulus_pa: " << num(fluid.bulk_modulus_pa()) << "\n"
-    << "    viscosity_pa_s: " << num(fluid.viscosity_pa_s()) << "\n"
-    << "    inlet { flow_rate_m2_s { "
-    << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(wing_q) + " }" : "constant: " + num(wing_q))
-    << (both ? " } }   # both wings: the total rate\n" : " } }   # one wing: half the total rate\n")
-    << "    initial_fill { front_m: " << num(p.notch_m()) << " pressure_pa: " << exact(sigma_n) << " }\n"
-    << "    virtual_opening_m: " << num(d.virtual_opening) << "\n";
-  if (d.matched_closure) {
-    // The dry tip zone carries the stress normal to the crack there: the
-    // notch's, or for a crack that turns towards sigma_H the minimum stress
-    // it turns to.
-    s << "    lag: TIP_ASYMPTOTE_MATCHED lag_pressure_pa: " << num(turning ? stresses.minimum : sigma_n) << "\n";
-  } else {
-    s << "    lag: FRONT_PRESSURE\n";
-  }
-  s << "    merge_fraction: 0.5\n    max_substeps: 1000\n  }\n}\n";
+  s << body.str();
   return {s.str(), d};
 }
 

@@ -1,14 +1,17 @@
 // A scene from physics alone (`hfmpm scene PROBLEM`): a plane-strain (KGD)
 // hydraulic fracture given as rock, in-situ stress, fluid, injection,
 // duration and notch (proto/hfmpm/problem.proto) becomes a full scene whose
-// every numerical setting is derived from that physics, each with its reason
-// as a comment (docs/scenes.md, "A scene from physics alone").
+// geometry (cell, body, particles) is sized from that physics. The numerical
+// method is left to the run, which derives it from the same physics
+// (hfmpm/coupling/method.hpp); the scene's comments list it with its reasons
+// (docs/scenes.md, "A scene from physics alone").
 #pragma once
 
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "hfmpm/coupling/method.hpp"
 #include "hfmpm/problem.pb.h"
 
 namespace hfmpm::app {
@@ -20,18 +23,11 @@ struct ProblemError : std::runtime_error {
   std::vector<std::string> problems;
 };
 
-// The plane-strain vertex solutions the builder sizes the run with
-// (zero lag, impermeable rock, Newtonian fluid; Q the total rate of both
-// wings; half-length l, mouth opening w0, net inlet pressure p0 at time t).
-struct Vertex {
-  double half_length = 0, opening = 0, net_pressure = 0;
-};
-// Viscosity-dominated (M): Spence and Sharp 1985, Adachi and Detournay 2002.
-Vertex m_vertex(double e_prime, double viscosity, double total_rate, double t);
-// Toughness-dominated (K): a uniformly loaded crack with K_I = K_Ic and the injected volume.
-Vertex k_vertex(double e_prime, double toughness, double total_rate, double t);
-// Km = K' / (E'^3 mu' Q)^(1/4), K' = sqrt(32/pi) K_Ic, mu' = 12 mu.
-double toughness_number(double e_prime, double viscosity, double total_rate, double toughness);
+// The vertex solutions and Km, as the derived method (hfmpm/coupling/method.hpp) has them.
+using method::k_vertex;
+using method::m_vertex;
+using method::toughness_number;
+using method::Vertex;
 
 // What the builder derived (also written into the scene's comments).
 // The problem's in-situ stress (compressive magnitudes, Pa) in the grid's
@@ -66,6 +62,9 @@ struct Derived {
   // alone") saw runs like this one stall or stop: one line each, also in the
   // scene's comments. Empty: inside what the matrix ran to completion.
   std::vector<std::string> cautions;
+  // The numerical method the run derives from the built scene (every key
+  // the scene leaves unset), with its rules: also in the scene's comments.
+  std::vector<method::Setting> method;
 };
 
 struct BuiltScene {

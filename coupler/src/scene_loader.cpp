@@ -9,8 +9,9 @@
 
 #include <filesystem>
 #include <fstream>
-#include <set>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 namespace hfmpm::coupling {
 namespace {
@@ -129,12 +130,19 @@ int line_of(const pb::TextFormat::ParseInfoTree* tree, const pb::Descriptor* typ
   return line;
 }
 
+// An override: the key as validation names it (numeric indices) and as written.
+struct Overridden {
+  std::string key;
+  std::string written;
+};
+
 std::string describe(const SceneProblem& p, const std::string& name, int line,
-                     const std::set<std::string>& overridden) {
+                     const std::vector<Overridden>& overridden) {
   std::string where = name;
-  for (const auto& key : overridden) {
+  for (const auto& o : overridden) {  // in order: a later override wins
+    const auto& key = o.key;
     if (p.key == key || p.key.rfind(key + ".", 0) == 0 || p.key.rfind(key + "[", 0) == 0) {
-      where = "--set " + key;
+      where = "--set " + o.written;
       line = 0;
     }
   }
@@ -151,12 +159,206 @@ std::string quote(const std::string& value) {
   return out + "\"";
 }
 
-}  // namespace
+// One component of a --set key: a field's name and, in brackets, one element
+// of a repeated field: an index (cracks[1]) or, where the elements are
+// messages with a string field `name`, a name (materials[rock],
+// materials["rock"]; quotes for a name that starts with a digit or a sign or
+// holds ']', with \" and \\ inside them).
+struct KeyPart {
+  std::string field;
+  bool bracket = false;
+  bool quoted = false;
+  std::string selector;  // between the brackets, without the quotes
+  std::string written;   // the brackets as written
+};
 
-SceneError::SceneError(const std::vector<std::string>& problems)
-    : std::runtime_error(join(problems, "\n")), problems_(problems) {}
+constexpr const char* kKeyForm =
+    "a key is NAME.NAME..., with [INDEX] or [NAME] after the name of a list, e.g. solid.mpm.cracks[0].x_m or "
+    "solid.mpm.materials[rock].youngs_modulus_pa";
 
-void apply_override(scene::Scene& scene, const std::string& assignment) {
+std::vector<KeyPart> split_key(const std::string& key) {
+  const auto refuse = [&](const std::string& why) {
+    return SceneError({"--set " + key + ": " + why + "; " + kKeyForm});
+  };
+  std::vector<KeyPart> parts;
+  std::size_t i = 0;
+  while (true) {
+    KeyPart part;
+    const auto stop = std::min(key.find_first_of(".[", i), key.size());
+    part.field = key.substr(i, stop - i);
+    i = stop;
+    if (i < key.size() && key[i] == '[') {
+      const auto open = i++;
+      part.bracket = true;
+      if (i < key.size() && (key[i] == '"' || key[i] == '\'')) {
+        const char mark = key[i++];
+        part.quoted = true;
+        bool closed = false;
+        while (i < key.size() && !closed) {
+          char ch = key[i++];
+          if (ch == mark) {
+            closed = true;
+          } else {
+            if (ch == '\\' && i < key.size()) ch = key[i++];
+            part.selector += ch;
+          }
+        }
+        if (!closed) throw refuse("the quote after '" + part.field + "[' is not closed");
+        if (i >= key.size() || key[i] != ']')
+          throw refuse("']' expected after the quoted name in '" + part.field + "['");
+      } else {
+        const auto close = key.find(']', i);
+        if (close == std::string::npos) throw refuse("'[' after '" + part.field + "' is not closed");
+        part.selector = key.substr(i, close - i);
+        if (part.selector.empty()) throw refuse("nothing between the brackets of '" + part.field + "[]'");
+        i = close;
+      }
+      ++i;  // past ']'
+      part.written = key.substr(open, i - open);
+      if (i < key.size() && key[i] != '.') {
+        throw refuse("'.' or the end expected after '" + part.field + part.written + "', not '" + key.substr(i, 1) +
+                     "'");
+      }
+    }
+    parts.push_back(part);
+    if (i >= key.size()) return parts;
+    ++i;  // past '.'
+  }
+}
+
+// The string field `name` of a repeated message field's elements, if they have one.
+const pb::FieldDescriptor* name_field(const pb::FieldDescriptor* field) {
+  if (field->cpp_type() != pb::FieldDescriptor::CPPTYPE_MESSAGE) return nullptr;
+  const auto* name = field->message_type()->FindFieldByName("name");
+  return name && !name->is_repeated() && name->type() == pb::FieldDescriptor::TYPE_STRING ? name : nullptr;
+}
+
+// A name as it is selected: [rock], or ["1a"] where it needs quotes.
+std::string bracketed(const std::string& name) {
+  const bool plain = !name.empty() && std::string("0123456789+-\"'").find(name.front()) == std::string::npos &&
+                     name.find(']') == std::string::npos;
+  return "[" + (plain ? name : quote(name)) + "]";
+}
+
+// "solid.mpm.cracks has 1 element; allowed: [0]", with the names where the elements have them.
+std::string elements_allowed(const pb::Message& message, const pb::FieldDescriptor* field, const std::string& path) {
+  const auto* reflection = message.GetReflection();
+  const int size = reflection->FieldSize(message, field);
+  std::string text = path + " has " +
+                     (size == 0   ? std::string("no elements")
+                      : size == 1 ? std::string("1 element")
+                                  : std::to_string(size) + " elements") +
+                     "; allowed: " +
+                     (size == 0   ? std::string("none")
+                      : size == 1 ? std::string("[0]")
+                                  : "[0] to [" + std::to_string(size - 1) + "]");
+  if (const auto* name = name_field(field); name && size > 0) {
+    constexpr int kMaxNames = 20;
+    std::vector<std::string> names;
+    for (int k = 0; k < size && k < kMaxNames; ++k) {
+      const auto& element = reflection->GetRepeatedMessage(message, field, k);
+      names.push_back(bracketed(element.GetReflection()->GetString(element, name)));
+    }
+    if (size > kMaxNames) names.push_back("...");
+    text += " or by name " + join(names, ", ");
+  }
+  return text;
+}
+
+// The element that `part`'s brackets select in `field` of `message` (`path`
+// is the field's key as written); throws SceneError naming what is allowed.
+int element_index(const pb::Message& message, const pb::FieldDescriptor* field, const KeyPart& part,
+                  const std::string& key, const std::string& path) {
+  const auto refuse = [&](const std::string& why) { return SceneError({"--set " + key + ": " + why}); };
+  if (!field->is_repeated()) {
+    throw refuse("'" + path + "' is not a list; brackets select one element of a repeated key");
+  }
+  const auto* reflection = message.GetReflection();
+  const int size = reflection->FieldSize(message, field);
+  const std::string& s = part.selector;
+  if (!part.quoted && std::isdigit(static_cast<unsigned char>(s.front())) == 0 && s.front() != '-' &&
+      s.front() != '+') {
+    // A name.
+  } else if (!part.quoted) {
+    const bool digits =
+        std::all_of(s.begin(), s.end(), [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)) != 0; });
+    if (!digits) {
+      throw refuse("'" + s + "' is not an index (a whole number from 0)" +
+                   (name_field(field) ? "; a name that starts with a digit or a sign is written in quotes, " +
+                                            part.field + bracketed(s)
+                                      : std::string()) +
+                   "; " + elements_allowed(message, field, path));
+    }
+    const auto first = s.find_first_not_of('0');
+    const std::string number = first == std::string::npos ? "0" : s.substr(first);
+    const long long index = number.size() > 10 ? -1 : std::stoll(number);
+    if (index < 0 || index >= size) {
+      const std::string example =
+          field->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE ? "[{...}, {...}]" : "[a, b]";
+      throw refuse(elements_allowed(message, field, path) + " (--set does not add elements: to add one, set the " +
+                   "whole list, --set '" + path + "=" + example + "')");
+    }
+    return static_cast<int>(index);
+  }
+  const auto* name = name_field(field);
+  if (!name) {
+    throw refuse((field->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE
+                      ? "the elements of " + path + " (" + field->message_type()->name() + ") have no name"
+                      : path + " holds values, not named elements") +
+                 ": select one by index, not by " + quote(s) + "; " + elements_allowed(message, field, path));
+  }
+  std::vector<int> found;
+  for (int k = 0; k < size; ++k) {
+    const auto& element = reflection->GetRepeatedMessage(message, field, k);
+    if (element.GetReflection()->GetString(element, name) == s) found.push_back(k);
+  }
+  if (found.empty()) {
+    throw refuse(path + " has no element named " + quote(s) + "; " + elements_allowed(message, field, path));
+  }
+  if (found.size() > 1) {
+    std::vector<std::string> indices;
+    for (int k : found) indices.push_back("[" + std::to_string(k) + "]");
+    throw refuse(path + " has " + std::to_string(found.size()) + " elements named " + quote(s) + " (" +
+                 join(indices, ", ") + "); select one by index");
+  }
+  return found.front();
+}
+
+// Replaces element `index` of repeated `field` of `message` by `value`
+// (one value, or one message in braces), written as in a scene file.
+void set_element(pb::Message& message, const pb::FieldDescriptor* field, int index, std::string value,
+                 const std::string& key, const std::string& written_value) {
+  if (field->type() == pb::FieldDescriptor::TYPE_STRING && value.front() != '"') value = quote(value);
+  const bool is_message = field->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE;
+  std::unique_ptr<pb::Message> scratch(message.New());
+  pb::TextFormat::Parser parser;
+  Collector collector("--set " + key);
+  parser.RecordErrorsTo(&collector);
+  const std::string separator = is_message && value.front() == '{' ? " " : ": ";
+  const auto* reflection = message.GetReflection();
+  std::vector<const pb::FieldDescriptor*> set;
+  const bool parsed = parser.MergeFromString(field->name() + separator + value, scratch.get());
+  if (parsed) reflection->ListFields(*scratch, &set);
+  if (!parsed || set.size() != 1 || set.front() != field) {
+    throw SceneError({"--set " + key + "=" + written_value + ": not a valid " +
+                      (is_message ? field->message_type()->name() : std::string(field->type_name())) + " value for " +
+                      key});
+  }
+  const int count = reflection->FieldSize(*scratch, field);
+  if (count != 1) {
+    throw SceneError({"--set " + key + "=" + written_value + ": " + std::to_string(count) +
+                      " values for one element (" + key + "); give one" +
+                      (is_message ? " message in braces, {...}" : "")});
+  }
+  // Appended (scratch holds this field alone), then swapped into place.
+  message.MergeFrom(*scratch);
+  const int last = reflection->FieldSize(message, field) - 1;
+  reflection->SwapElements(&message, field, index, last);
+  reflection->RemoveLast(&message, field);
+}
+
+// apply_override; returns the key as validation names it (indices, not names).
+std::string apply_one(scene::Scene& scene, const std::string& assignment) {
   if (assignment.size() > kMaxAssignmentBytes) {
     throw SceneError({"--set " + assignment.substr(0, std::min<std::size_t>(assignment.find('='), 100)) + ": " +
                       std::to_string(assignment.size()) + " characters; an override may have at most " +
@@ -169,25 +371,43 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
   const std::string key = assignment.substr(0, equals);
   std::string value = assignment.substr(equals + 1);
   if (value.empty()) throw SceneError({"--set " + key + "=: no value given; write --set " + key + "=VALUE"});
-  pb::Message* message = &scene;
-  std::stringstream parts(key);
-  std::string part, path;
-  std::vector<std::string> components;
-  while (std::getline(parts, part, '.')) components.push_back(part);
+  const auto components = split_key(key);
+  scene::Scene result = scene;  // the scene is left as it was if the override is refused
+  pb::Message* message = &result;
+  std::string path;     // the key up to here, as written
+  std::string indexed;  // the same with indices for names
   for (std::size_t i = 0; i < components.size(); ++i) {
+    const auto& part = components[i];
     const auto* type = message->GetDescriptor();
-    const auto* field = type->FindFieldByName(components[i]);
-    path += (i ? "." : "") + components[i];
+    const auto* reflection = message->GetReflection();
+    const auto* field = type->FindFieldByName(part.field);
+    path += (i ? "." : "") + part.field;
+    indexed += (i ? "." : "") + part.field;
     if (!field) {
-      throw SceneError({"--set " + key + ": '" + components[i] + "' is not a key of " +
+      throw SceneError({"--set " + key + ": '" + part.field + "' is not a key of " +
                         (i ? type->name() : std::string("the scene")) + "; allowed: " + field_names(type)});
     }
-    if (i + 1 < components.size()) {
-      if (field->type() != pb::FieldDescriptor::TYPE_MESSAGE || field->is_repeated()) {
+    const bool last = i + 1 == components.size();
+    int index = -1;
+    if (part.bracket) {
+      index = element_index(*message, field, part, key, path);
+      path += part.written;
+      indexed += "[" + std::to_string(index) + "]";
+    } else if (!last && field->is_repeated() && field->cpp_type() == pb::FieldDescriptor::CPPTYPE_MESSAGE) {
+      throw SceneError({"--set " + key + ": '" + path + "' is a list; select one element, " + path + "[0]." +
+                        components[i + 1].field + "; " + elements_allowed(*message, field, path)});
+    }
+    if (!last) {
+      if (field->cpp_type() != pb::FieldDescriptor::CPPTYPE_MESSAGE) {
         throw SceneError({"--set " + key + ": '" + path + "' holds a value, not further keys"});
       }
-      message = message->GetReflection()->MutableMessage(message, field);
+      message = index >= 0 ? reflection->MutableRepeatedMessage(message, field, index)
+                           : reflection->MutableMessage(message, field);
       continue;
+    }
+    if (index >= 0) {
+      set_element(*message, field, index, value, key, assignment.substr(equals + 1));
+      break;
     }
     if (field->type() == pb::FieldDescriptor::TYPE_STRING) {
       if (field->is_repeated()) {
@@ -198,7 +418,7 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
     } else if (field->is_repeated() && (value.empty() || value.front() != '[')) {
       value = "[" + value + "]";
     }
-    message->GetReflection()->ClearField(message, field);
+    reflection->ClearField(message, field);
     pb::TextFormat::Parser parser;
     Collector collector("--set " + key);
     parser.RecordErrorsTo(&collector);
@@ -211,10 +431,19 @@ void apply_override(scene::Scene& scene, const std::string& assignment) {
                         " value for " + key});
     }
   }
+  scene = std::move(result);
+  return indexed;
 }
 
+}  // namespace
+
+SceneError::SceneError(const std::vector<std::string>& problems)
+    : std::runtime_error(join(problems, "\n")), problems_(problems) {}
+
+void apply_override(scene::Scene& scene, const std::string& assignment) { apply_one(scene, assignment); }
+
 scene::Scene parse_scene(const std::string& file_text, const std::string& name, const SceneRules& rules,
-                         const std::vector<std::string>& overrides) {
+                         const std::vector<std::string>& overrides, std::vector<method::Setting>* derived) {
   if (file_text.size() > kMaxSceneBytes) {
     throw SceneError({name + ": " + std::to_string(file_text.size()) + " bytes; a scene file may have at most " +
                       std::to_string(kMaxSceneBytes)});
@@ -236,22 +465,34 @@ scene::Scene parse_scene(const std::string& file_text, const std::string& name, 
     if (collector.errors_.empty()) collector.errors_.push_back(name + ": not a valid scene file");
     throw SceneError(collector.errors_);
   }
-  std::set<std::string> overridden;
+  std::vector<Overridden> overridden;
   for (const auto& assignment : overrides) {
-    apply_override(scene, assignment);
-    overridden.insert(assignment.substr(0, assignment.find('=')));
+    overridden.push_back({apply_one(scene, assignment), assignment.substr(0, assignment.find('='))});
   }
+  // The method keys left unset, derived from the physics (the rules then
+  // check the scene as it will run; a derived value they refuse is named so).
+  std::vector<method::Setting> settings;
+  scene = method::with_method(scene, &settings);
   const auto problems = validate(scene, rules);
   if (!problems.empty()) {
     std::vector<std::string> lines;
-    for (const auto& p : problems)
-      lines.push_back(describe(p, name, line_of(&tree, scene.GetDescriptor(), p.key), overridden));
+    for (const auto& p : problems) {
+      std::string line = describe(p, name, line_of(&tree, scene.GetDescriptor(), p.key), overridden);
+      for (const auto& s : settings) {
+        if (p.key == s.key || p.key.rfind(s.key + ".", 0) == 0) {
+          line += " (" + s.key + " was derived: " + s.rule + "; set it in the scene to choose another value)";
+        }
+      }
+      lines.push_back(line);
+    }
     throw SceneError(lines);
   }
+  if (derived) *derived = settings;
   return scene;
 }
 
-scene::Scene load_scene(const std::string& path, const SceneRules& rules, const std::vector<std::string>& overrides) {
+scene::Scene load_scene(const std::string& path, const SceneRules& rules, const std::vector<std::string>& overrides,
+                        std::vector<method::Setting>* derived) {
   std::error_code error;
   if (std::filesystem::is_directory(path, error)) throw SceneError({path + ": is a directory, not a scene file"});
   std::ifstream in(path, std::ios::binary);
@@ -263,7 +504,7 @@ scene::Scene load_scene(const std::string& path, const SceneRules& rules, const 
   }
   std::stringstream text;
   text << in.rdbuf();
-  return parse_scene(text.str(), path, rules, overrides);
+  return parse_scene(text.str(), path, rules, overrides, derived);
 }
 
 namespace {

@@ -88,6 +88,8 @@ struct Bounds {
   // (h = 0.035 m) at every frame.
   int wings = 1;
   double apart = 0.02, apart_cells = 0.5;
+  // The virtual film (fluid.mpm.virtual_opening_m) the notch's fluid fills.
+  double film = 2e-5;
 };
 
 // (start wing, end wing) lengths from x = 0 at every frame of a run's solid.h5.
@@ -114,7 +116,7 @@ void expect_ci_scene_follows(const std::string& scene, double Q, Reference refer
   ASSERT_GE(t.size(), 20u);
   ASSERT_NEAR(t.back(), 5, 1e-3);
   constexpr double kRamp = 0.05, kSigma0 = 1e5, kNotch = 0.15;
-  const double kInitial = bounds.wings * kNotch * 2e-5;  // the notch's fluid: the virtual film x 0.15 m per wing
+  const double kInitial = bounds.wings * kNotch * bounds.film;  // the notch's fluid: the virtual film x 0.15 m per wing
   const double p_max = *std::max_element(p_in.begin(), p_in.end());
   const double j_min = 1 - 0.0894 * std::log1p(p_max / (0.0894 * bulk_modulus));  // Tait, c = 0.0894
   double work = 0, worst_length = 0, worst_opening = 0, worst_pressure = 0;

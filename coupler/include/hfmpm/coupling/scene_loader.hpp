@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "hfmpm/coupling/method.hpp"
 #include "hfmpm/proto/scene_rules.hpp"
 #include "hfmpm/scene.pb.h"
 
@@ -31,14 +32,23 @@ using proto::SceneRules;
 
 // Reads `path`, applies `overrides` ("key.path=value", in order), validates
 // with the coupler's rules and the sides' `rules`.
+// The scene's method keys it leaves unset are derived from its physics
+// (hfmpm/coupling/method.hpp) before validation; `derived` gets them, with
+// their rules.
 scene::Scene load_scene(const std::string& path, const SceneRules& rules,
-                        const std::vector<std::string>& overrides = {});
+                        const std::vector<std::string>& overrides = {},
+                        std::vector<method::Setting>* derived = nullptr);
 // Same from text; `name` stands for the file in messages.
 scene::Scene parse_scene(const std::string& text, const std::string& name, const SceneRules& rules,
-                         const std::vector<std::string>& overrides = {});
+                         const std::vector<std::string>& overrides = {},
+                         std::vector<method::Setting>* derived = nullptr);
 
 // Sets one value by its dotted key path; throws SceneError for an unknown key
 // or a value of the wrong type. Repeated fields take "[a, b]" and are replaced.
+// Brackets select one existing element of a repeated field, by index
+// (solid.mpm.cracks[1].x_m, solid.mpm.cracks[0].x_m[1]) or, where its messages
+// have a string `name`, by name (solid.mpm.materials[rock], materials["rock"]);
+// none is added. A refused override leaves `scene` as it was.
 void apply_override(scene::Scene& scene, const std::string& assignment);
 
 // Every rule the scene breaks (empty if valid): the coupler's (name, time,

@@ -1,4 +1,4 @@
-// Numbers as the scene builder writes them (internal to app/).
+// Numbers as the scene builder and the derived method write them.
 #pragma once
 
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace hfmpm::app::text {
+namespace hfmpm::text {
 
 inline std::string join(const std::vector<std::string>& lines) {
   std::string out;
@@ -42,4 +42,4 @@ inline double significant(double x, int digits, bool down) {
   return (down ? std::floor(x * scale) : std::round(x * scale)) / scale;
 }
 
-}  // namespace hfmpm::app::text
+}  // namespace hfmpm::text

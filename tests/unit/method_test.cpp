@@ -1,0 +1,253 @@
+// The derived method (coupler/src/method.cpp, docs/scenes.md "The derived
+// method"): the physics read from a hand-written scene, the keys it fills
+// and the ones it leaves, against the numbers computed here from the rules.
+#include "hfmpm/coupling/method.hpp"
+
+#include <google/protobuf/text_format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "hfmpm/coupling/scene_loader.hpp"
+#include "scene_test_support.hpp"
+#include "test_support.hpp"
+
+namespace hfmpm::method {
+namespace {
+
+using ::testing::HasSubstr;
+
+scene::Scene parsed(const std::string& text) {
+  scene::Scene s;
+  EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &s)) << text;
+  return s;
+}
+
+// The lab viscosity-dominated KGD written with its physics only
+// (scenarios/kgd-physics-only-ci.scene).
+scene::Scene physics_only() { return parsed(hfmpm::test::read_file(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"))); }
+
+const Setting* find(const std::vector<Setting>& settings, const std::string& key) {
+  for (const auto& s : settings)
+    if (s.key == key) return &s;
+  return nullptr;
+}
+
+TEST(Method, ReadsTheFluidDrivenCracksPhysicsFromAScene) {
+  std::string why;
+  const auto p = physics_of(physics_only(), &why);
+  ASSERT_TRUE(p) << why;
+  EXPECT_DOUBLE_EQ(p->physics.youngs_modulus, 1e7);
+  EXPECT_DOUBLE_EQ(p->physics.toughness, 100);
+  EXPECT_DOUBLE_EQ(p->physics.viscosity, 0.01);
+  EXPECT_DOUBLE_EQ(p->physics.total_rate, 2.5e-4);  // an edge crack: twice the wing's 1.25e-4
+  EXPECT_NEAR(p->physics.effective_s, 5 - 0.025, 1e-12);  // a ramp over 0.05 s: half of it lost
+  EXPECT_DOUBLE_EQ(p->physics.notch, 0.15);
+  EXPECT_DOUBLE_EQ(p->physics.normal_stress, 1e5);
+  EXPECT_DOUBLE_EQ(p->physics.shear_stress, 0);
+  EXPECT_TRUE(p->physics.symmetric);
+  EXPECT_DOUBLE_EQ(p->cell, 0.035);
+  EXPECT_DOUBLE_EQ(p->reach, 3);  // the body reaches 3 m along the crack, 3.05 m across
+  EXPECT_TRUE(p->toughness_given);
+}
+
+// Every method key of the physics-only scene, from the rules written out here.
+TEST(Method, DerivesTheVerifiedMethodForAPhysicsOnlyScene) {
+  std::vector<Setting> applied;
+  const scene::Scene s = with_method(physics_only(), &applied);
+  const double e_prime = 1e7 / (1 - 0.0625);
+  const double km = std::sqrt(32 / std::numbers::pi) * 100 / std::pow(e_prime * e_prime * e_prime * 0.12 * 2.5e-4, 0.25);
+  EXPECT_NEAR(km, 0.0231, 1e-4);
+  const Vertex m = m_vertex(e_prime, 0.01, 2.5e-4, 4.975);
+  // Density scaling: the scaled P-wave crosses l in 0.5% of 5 s, rounded down to 2 digits.
+  const double c_p = std::sqrt(1e7 * 0.75 / (1.25 * 0.5) / 2500);
+  const double scaling = std::pow(c_p * 0.005 * 5 / m.half_length, 2);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().density_scaling(), std::floor(scaling * 10) / 10);
+  EXPECT_NEAR(s.solid().mpm().density_scaling(), 8.3, 1e-12);
+  // Damping: 2% lag of the body's lowest mode over its reach of 3 m, at most critical.
+  const double omega = std::numbers::pi * c_p / std::sqrt(8.3) / (2 * 3);
+  const double t_3 = 4.975 * std::pow(0.45 / m.half_length, 1.5);
+  const double alpha = std::min(2 * omega, 0.02 * omega * omega * t_3);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().damping().grid_alpha_per_s(), std::floor(alpha));  // 2 digits: 10
+  EXPECT_DOUBLE_EQ(s.solid().mpm().damping().pic_fraction(), 0.5);
+  // Growth: 2 g h within 2.5% of three notch lengths (0.01125 m): g = 1/8 at h = 0.035.
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().growth_cells(), 0.125);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().max_lag_cells(), 0.125);
+  EXPECT_TRUE(s.solid().mpm().fracture().propagate());
+  EXPECT_EQ(s.solid().mpm().fracture().direction(), scene::FractureSpec::STRAIGHT);
+  EXPECT_FALSE(s.solid().mpm().fracture().has_settle_transits());  // viscosity-dominated: no settling
+  EXPECT_TRUE(s.solid().mpm().fracture().surfaces_from_material());
+  EXPECT_TRUE(s.solid().mpm().in_situ_reference());
+  EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
+  EXPECT_DOUBLE_EQ(s.time().safety_factor(), 0.9);
+  const auto& f = s.fluid().mpm();
+  EXPECT_EQ(f.lag(), scene::MpmFluid::TIP_ASYMPTOTE_MATCHED);  // Km < 2
+  EXPECT_DOUBLE_EQ(f.lag_pressure_pa(), 1e5);
+  EXPECT_DOUBLE_EQ(f.virtual_opening_m(), std::round(0.01 * m.opening * 1e6) / 1e6);  // 1.4e-5
+  EXPECT_DOUBLE_EQ(f.merge_fraction(), 0.5);
+  EXPECT_EQ(f.max_substeps(), 1000u);
+  EXPECT_DOUBLE_EQ(f.initial_fill().front_m(), 0.15);
+  EXPECT_DOUBLE_EQ(f.initial_fill().pressure_pa(), 1e5);
+  // Each derived key is listed once with a rule.
+  for (const char* key : {"coupling.scheme", "solid.mpm.density_scaling", "fluid.mpm.lag", "fluid.mpm.initial_fill",
+                          "solid.mpm.fracture.surfaces_from_material"}) {
+    const Setting* setting = find(applied, key);
+    ASSERT_TRUE(setting) << key;
+    EXPECT_FALSE(setting->rule.empty()) << key;
+  }
+  // Derived once, the scene has nothing left to derive.
+  std::vector<Setting> again;
+  with_method(s, &again);
+  EXPECT_TRUE(again.empty());
+}
+
+TEST(Method, KeepsEveryKeyTheSceneSets) {
+  scene::Scene written = physics_only();
+  auto& m = *written.mutable_solid()->mutable_mpm();
+  m.set_density_scaling(3);
+  m.mutable_damping()->set_grid_alpha_per_s(7);
+  m.mutable_fracture()->set_surfaces_from_material(false);
+  m.mutable_fracture()->set_direction(scene::FractureSpec::MAX_HOOP_STRESS);
+  written.mutable_fluid()->mutable_mpm()->set_lag(scene::MpmFluid::FRONT_PRESSURE);
+  written.mutable_coupling()->set_exchange_interval(5);  // IMPLICIT needs 1: the scheme stays JACOBI
+  std::vector<Setting> applied;
+  const scene::Scene s = with_method(written, &applied);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().density_scaling(), 3);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().damping().grid_alpha_per_s(), 7);
+  EXPECT_FALSE(s.solid().mpm().fracture().surfaces_from_material());
+  EXPECT_EQ(s.solid().mpm().fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);
+  EXPECT_FALSE(s.fluid().mpm().has_lag_pressure_pa());  // no zero-lag tip solution: no lag pressure
+  EXPECT_EQ(s.coupling().scheme(), scene::Coupling::JACOBI);
+  EXPECT_FALSE(s.time().has_safety_factor());
+  for (const char* key : {"solid.mpm.density_scaling", "solid.mpm.damping.grid_alpha_per_s", "coupling.scheme",
+                          "fluid.mpm.lag", "solid.mpm.fracture.direction"}) {
+    EXPECT_FALSE(find(applied, key)) << key;
+  }
+}
+
+// Toughness-dominated (kgd-toughness-ci's physics): the settling wait and
+// the load released over it; the settle a scene sets bounds the release.
+TEST(Method, ToughnessDominatedCrackSettlesAfterEachStep) {
+  scene::Scene written = physics_only();
+  auto& mat = *written.mutable_solid()->mutable_mpm()->mutable_materials(0);
+  mat.set_toughness_pa_sqrt_m(25e3);
+  written.mutable_fluid()->mutable_mpm()->set_viscosity_pa_s(0.001);
+  written.mutable_fluid()->mutable_mpm()->mutable_inlet()->mutable_flow_rate_m2_s()->mutable_ramp()->set_v1(4.15e-4);
+  const scene::Scene s = with_method(written);
+  EXPECT_EQ(s.fluid().mpm().lag(), scene::MpmFluid::FRONT_PRESSURE);  // Km = 7.6
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().growth_cells(), 0.25);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().settle_transits(), 2);
+  EXPECT_DOUBLE_EQ(s.solid().mpm().fracture().release_transits(), 2);
+  written.mutable_solid()->mutable_mpm()->mutable_fracture()->set_settle_transits(1);
+  EXPECT_DOUBLE_EQ(with_method(written).solid().mpm().fracture().release_transits(), 1);
+}
+
+// A well inside the body: the inlet's rate is both wings', the notch half the crack.
+TEST(Method, InletVertexSharesTheRateBetweenTheWings) {
+  scene::Scene written = physics_only();
+  auto& crack = *written.mutable_solid()->mutable_mpm()->mutable_cracks(0);
+  crack.clear_x_m();
+  crack.clear_y_m();
+  for (const double x : {-0.15, 0.0, 0.15}) {
+    crack.add_x_m(x);
+    crack.add_y_m(0);
+  }
+  crack.set_start_is_tip(true);
+  crack.set_inlet_vertex(1);
+  const auto p = physics_of(written);
+  ASSERT_TRUE(p);
+  EXPECT_DOUBLE_EQ(p->physics.total_rate, 1.25e-4);
+  EXPECT_DOUBLE_EQ(p->physics.notch, 0.15);
+}
+
+// A notch at 30 degrees under 150 / 100 kPa with sigma_H along x: the tips
+// turn (hoop stress) and the dry zone carries the minimum stress.
+TEST(Method, InclinedNotchUnderAnisotropicStressTurns) {
+  scene::Scene written = physics_only();
+  auto& m = *written.mutable_solid()->mutable_mpm();
+  for (auto& r : *m.mutable_regions()) r.mutable_initial_stress()->set_xx_pa(-1.5e5);
+  auto& crack = *m.mutable_cracks(0);
+  crack.set_x_m(1, 0.15 * std::cos(std::numbers::pi / 6));
+  crack.set_y_m(1, 0.15 * std::sin(std::numbers::pi / 6));
+  const auto p = physics_of(written);
+  ASSERT_TRUE(p);
+  EXPECT_NEAR(p->physics.normal_stress, 1.5e5 * 0.25 + 1e5 * 0.75, 1e-6);
+  EXPECT_NEAR(std::abs(p->physics.shear_stress), 5e4 * std::sin(std::numbers::pi / 6) * std::cos(std::numbers::pi / 6),
+              1e-6);
+  EXPECT_DOUBLE_EQ(p->physics.minimum_stress, 1e5);
+  EXPECT_FALSE(p->physics.symmetric);
+  const scene::Scene s = with_method(written);
+  EXPECT_EQ(s.solid().mpm().fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
+  EXPECT_DOUBLE_EQ(s.fluid().mpm().lag_pressure_pa(), 1e5);
+  EXPECT_NEAR(s.fluid().mpm().initial_fill().pressure_pa(), 112500, 1e-6);
+}
+
+// A dry scene gets the faces from the material and, with its in-situ
+// stress in equilibrium, that stress as the reference; nothing else.
+TEST(Method, DrySceneGetsTheFacesAndTheInSituReferenceOnly) {
+  scene::Scene written = physics_only();
+  written.clear_fluid();
+  std::vector<Setting> applied;
+  const scene::Scene s = with_method(written, &applied);
+  ASSERT_EQ(applied.size(), 2u);
+  EXPECT_TRUE(s.solid().mpm().fracture().surfaces_from_material());
+  EXPECT_TRUE(s.solid().mpm().in_situ_reference());
+  EXPECT_FALSE(s.coupling().has_scheme());
+  EXPECT_FALSE(s.solid().mpm().has_density_scaling());
+  // Regions whose stresses differ across an interface: no reference state.
+  written.mutable_solid()->mutable_mpm()->mutable_regions(1)->mutable_initial_stress()->set_xx_pa(-2e5);
+  EXPECT_FALSE(with_method(written).solid().mpm().has_in_situ_reference());
+}
+
+// A pressure inlet has no vertex to size by: the general keys, and why not the rest.
+TEST(Method, PressureInletGetsTheGeneralKeysAndSaysWhy) {
+  scene::Scene written = physics_only();
+  written.mutable_fluid()->mutable_mpm()->mutable_inlet()->mutable_pressure_pa()->set_constant(2e5);
+  std::vector<Setting> applied;
+  const scene::Scene s = with_method(written, &applied);
+  EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
+  EXPECT_FALSE(s.solid().mpm().has_density_scaling());
+  const Setting* why = find(applied, "(fluid-driven crack)");
+  ASSERT_TRUE(why);
+  EXPECT_THAT(why->rule, HasSubstr("pressure, not a flow rate"));
+}
+
+// The volume a rate function injects, as the time at its end rate.
+TEST(Method, EffectiveTimeOfTheInjection) {
+  auto time_of = [](const std::string& rate) {
+    scene::Scene s = physics_only();
+    auto* f = s.mutable_fluid()->mutable_mpm()->mutable_inlet()->mutable_flow_rate_m2_s();
+    f->Clear();
+    EXPECT_TRUE(google::protobuf::TextFormat::MergeFromString(rate, f)) << rate;
+    const auto p = physics_of(s);
+    return p ? p->physics.effective_s : -1.0;
+  };
+  EXPECT_DOUBLE_EQ(time_of("constant: 1e-4"), 5);
+  EXPECT_NEAR(time_of("ramp { t1: 1 v1: 1e-4 }"), 4.5, 1e-12);
+  // To 5 s: 1e-4 for 2 s, then rising to 1.375e-4 over 3 s.
+  EXPECT_NEAR(time_of("table { t: [0, 2, 10] v: [1e-4, 1e-4, 2e-4] }"), (2e-4 + 3 * 1.1875e-4) / 1.375e-4, 1e-9);
+  EXPECT_NEAR(time_of("power { scale: 1e-4 exponent: 1 }"), 2.5, 1e-12);
+  EXPECT_EQ(time_of("constant: 0"), -1.0);  // no injection at the end: no vertex
+}
+
+// Through the loader: hfmpm run's path. The derived keys are checked by the
+// sides' rules; a scene's own key set against a derived one is named.
+TEST(Method, TheLoaderDerivesAndReportsTheMethod) {
+  std::vector<Setting> derived;
+  const auto s = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"),
+                                             hfmpm::test::side_rules(), {}, &derived);
+  EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
+  EXPECT_GE(derived.size(), 19u);
+  const std::string text = describe(derived, "#   ");
+  EXPECT_THAT(text, HasSubstr("#   solid.mpm.density_scaling: 8.3   # quasi-static"));
+  // A lag pressure the scene sets, beside the derived matched closure, is kept.
+  const auto kept = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"),
+                                                hfmpm::test::side_rules(), {"fluid.mpm.lag_pressure_pa=2e5"});
+  EXPECT_DOUBLE_EQ(kept.fluid().mpm().lag_pressure_pa(), 2e5);
+}
+
+}  // namespace
+}  // namespace hfmpm::method
