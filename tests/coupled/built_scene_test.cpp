@@ -25,7 +25,10 @@
 // Measured (5 December; front, opening, pressure, volume balance): lab
 // viscosity 3.6%, 5.1%, 8.1%, 1e-4; field E = 30 GPa 3.9%, 4.8%, 7.7%, 5e-4;
 // field nu = 0.15 4.0%, 5.0%, 7.3%, 5e-4; lab toughness 4.5%, 8.4%, 16.2%,
-// 1e-4. 36 s for the four, two at a time.
+// 1e-4. 36 s for the four, two at a time. With the method derived at run
+// time and the settling cap at the tip's final speed (7 December): 4.3%,
+// 4.2%, 7.0%; 4.3%, 4.1%, 6.5%; 4.3%, 4.3%, 5.9%; lab toughness 4.5%, 8.5%,
+// 17.9%; 30-45 s.
 // - Every case: the water's volume (sum of l w) is the injected volume plus
 //   the notch's virtual film within 2% once the crack is three notch lengths
 //   long, and the run completes.
