@@ -62,6 +62,33 @@ void derive_key(scene::Scene& scene, std::vector<Setting>& applied, const std::s
   applied.push_back({key, value, rule});
 }
 
+// A rate function the scene's rules would accept, so that it can be
+// evaluated here (the method is derived before those rules run).
+bool well_formed(const scene::TimeFunction& f) {
+  auto finite = [](double v) { return std::isfinite(v); };
+  switch (f.kind_case()) {
+    case scene::TimeFunction::kConstant:
+      return finite(f.constant());
+    case scene::TimeFunction::kRamp:
+      return f.ramp().has_t1() && f.ramp().has_v1() && finite(f.ramp().t0()) && finite(f.ramp().v0()) &&
+             finite(f.ramp().t1()) && finite(f.ramp().v1()) && f.ramp().t1() > f.ramp().t0();
+    case scene::TimeFunction::kTable: {
+      const auto& t = f.table().t();
+      const auto& v = f.table().v();
+      if (t.empty() || t.size() != v.size()) return false;
+      for (int i = 0; i < t.size(); ++i) {
+        if (!finite(t[i]) || !finite(v[i]) || (i > 0 && !(t[i] > t[i - 1]))) return false;
+      }
+      return true;
+    }
+    case scene::TimeFunction::kPower:
+      return finite(f.power().scale()) && finite(f.power().exponent()) && f.power().exponent() >= 0 &&
+             finite(f.power().t_ref()) && f.power().t_ref() > 0;
+    default:
+      return false;
+  }
+}
+
 // The injected volume over [0, end] divided by the rate at `end`: the time
 // the end rate takes to inject it (a constant rate: `end`; a ramp over t_r
 // from zero: end - t_r / 2). Ramps and tables are integrated exactly between
@@ -243,6 +270,8 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
   const auto& m = s.solid().mpm();
   const auto& f = s.fluid().mpm();
   if (!f.inlet().has_flow_rate_m2_s()) return refuse("the fluid's inlet gives a pressure, not a flow rate");
+  if (!well_formed(f.inlet().flow_rate_m2_s())) return refuse("the inlet's flow rate is not a valid function yet");
+  if (!(std::isfinite(s.time().end_s()) && s.time().end_s() > 0)) return refuse("no valid time.end_s yet");
   // The fluid's crack: the first listed, or the first with a mouth or a well.
   const scene::CrackSpecScene* crack = nullptr;
   if (f.crack_ids_size() > 0) {
@@ -339,9 +368,16 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
     }
   }
   out.reach = std::min(std::max(x - x0, x1 - x), std::max(y - y0, y1 - y));
-  if (!(out.cell > 0) || !(out.reach > 0) || !(p.notch > 0) || !(p.youngs_modulus > 0) || !(p.density > 0) ||
-      !(p.end_s > 0)) {
-    return refuse("the body, the cell or the crack has no size");
+  // Only physics the scene's rules would accept: anything else gets no
+  // derived numbers, and the rules then name what is wrong.
+  const bool finite = std::isfinite(out.cell) && std::isfinite(out.reach) && std::isfinite(p.notch) &&
+                      std::isfinite(p.youngs_modulus) && std::isfinite(p.density) && std::isfinite(p.end_s) &&
+                      std::isfinite(p.toughness) && std::isfinite(p.total_rate) && std::isfinite(p.effective_s) &&
+                      std::isfinite(p.normal_stress) && std::isfinite(p.shear_stress) &&
+                      std::isfinite(p.minimum_stress) && std::isfinite(p.viscosity);
+  if (!finite || !(out.cell > 0) || !(out.reach > 0) || !(p.notch > 0) || !(p.youngs_modulus > 0) ||
+      !(p.density > 0) || !(p.end_s > 0) || !(p.poisson_ratio >= 0 && p.poisson_ratio < 0.5) || !(p.toughness >= 0)) {
+    return refuse("the body, the rock, the cell or the crack is not valid yet (the scene's rules say what)");
   }
   return out;
 }

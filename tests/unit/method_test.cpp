@@ -251,3 +251,53 @@ TEST(Method, TheLoaderDerivesAndReportsTheMethod) {
 
 }  // namespace
 }  // namespace hfmpm::method
+
+namespace hfmpm::method {
+namespace {
+
+// Hostile physics: the method is derived before the scene's rules run, so it
+// must neither crash nor invent numbers from it; the rules then name the
+// problem, not a derived key.
+TEST(Method, HostilePhysicsGetsNoDerivedNumbersAndTheRulesNameIt) {
+  const std::vector<std::string> bad = {
+      "solid.mpm.materials[0].youngs_modulus_pa=nan",
+      "solid.mpm.materials[0].poisson_ratio=0.7",
+      "fluid.mpm.inlet.flow_rate_m2_s={table { t: [0, 1] v: [1e-4] }}",
+      "fluid.mpm.inlet.flow_rate_m2_s={table { t: [] v: [] }}",
+      "fluid.mpm.inlet.flow_rate_m2_s={table { t: [1, 0] v: [1e-4, 1e-4] }}",
+      "fluid.mpm.inlet.flow_rate_m2_s={ramp { t0: 0 v0: 0 }}",
+      "fluid.mpm.inlet.flow_rate_m2_s={power { scale: 1e-4 exponent: -1 }}",
+      "time.end_s=inf",
+      "solid.mpm.cracks[0].x_m=[0, 0]",
+      "solid.mpm.cell_size_m=-1",
+  };
+  int derived_from = 0;
+  for (const auto& assignment : bad) {
+    SCOPED_TRACE(assignment);
+    scene::Scene s = physics_only();
+    try {
+      hfmpm::coupling::apply_override(s, assignment);
+    } catch (const hfmpm::coupling::SceneError&) {
+      continue;  // refused as an override already
+    }
+    ++derived_from;
+    EXPECT_FALSE(physics_of(s));
+    std::vector<Setting> applied;
+    EXPECT_NO_THROW(with_method(s, &applied));
+    for (const auto& setting : applied) {
+      EXPECT_EQ(setting.value.find("nan"), std::string::npos) << setting.key;
+      EXPECT_EQ(setting.value.find("inf"), std::string::npos) << setting.key;
+    }
+    try {
+      hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"), hfmpm::test::side_rules(),
+                                  {assignment});
+      ADD_FAILURE() << "accepted";
+    } catch (const hfmpm::coupling::SceneError& e) {
+      EXPECT_EQ(std::string(e.what()).find("was derived"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(derived_from, static_cast<int>(bad.size()));  // each reached the derivation
+}
+
+}  // namespace
+}  // namespace hfmpm::method
