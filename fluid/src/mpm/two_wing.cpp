@@ -170,6 +170,13 @@ int TwoWingFluid::advance(double dt) {
       have_prev = true;
       const double q = std::abs(wings_[0].config().inlet.flow_rate(wings_[0].time() + dt));
       x = slope_ > 0 ? x - r / slope_ : x - (r > 0 ? 1 : -1) * 1e-2 * std::max({q, std::abs(x), 1e-12});
+      // Through the well a wing can give the other no more than its share of
+      // the inflow and half the fluid its inlet particle holds over the step.
+      auto most = [&](const FluidSolver& w) {
+        const double m0 = w.particles().mass.empty() ? 0.0 : w.particles().mass.front();
+        return 0.5 * q + 0.5 * m0 / (w.config().density * dt);
+      };
+      x = std::clamp(x, -most(wings_[1]), most(wings_[0]));
     }
     across = found;
   }
