@@ -308,8 +308,8 @@ int run(const std::string& command, const std::vector<std::string>& args) {
   // A scene file's unset method keys are derived from its physics (docs/scenes.md,
   // "The derived method"); a checkpoint's own scene is continued with the method it ran.
   std::vector<method::Setting> derived;
-  const scene::Scene scene = scene_path.empty() ? restart_point->state.scene()
-                                                : coupling::load_scene(scene_path, rules, overrides, &derived);
+  const scene::Scene scene =
+      scene_path.empty() ? restart_point->state.scene() : coupling::load_scene(scene_path, rules, overrides, &derived);
   if (restart_point && scene_path.empty()) {
     // The checkpoint's own scene, checked as a scene file is: a checkpoint this
     // program wrote holds a valid one, but a damaged or foreign one must be

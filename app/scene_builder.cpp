@@ -209,8 +209,8 @@ BuiltScene build_scene(const problem::Problem& p) {
        << edge("RIGHT", -stresses.xx, -stresses.xy) << edge("TOP", -stresses.yy, stresses.xy)
        << edge("BOTTOM", -stresses.yy, stresses.xy)
        << (both ? "    silent_edges: [LEFT, RIGHT, TOP, BOTTOM]\n" : "    silent_edges: [RIGHT, TOP, BOTTOM]\n")
-       << (both ? "    cracks { x_m: [" + num(-notch_x) + ", 0, " + num(notch_x) + "] y_m: [" + num(-notch_y) + ", 0, " +
-                      num(notch_y) + "] start_is_tip: true end_is_tip: true inlet_vertex: 1" + friction +
+       << (both ? "    cracks { x_m: [" + num(-notch_x) + ", 0, " + num(notch_x) + "] y_m: [" + num(-notch_y) +
+                      ", 0, " + num(notch_y) + "] start_is_tip: true end_is_tip: true inlet_vertex: 1" + friction +
                       " }   # the well at (0, 0)\n"
                 : "    cracks { x_m: [0, " + num(p.notch_m()) + "] y_m: [0, 0] start_is_tip: false end_is_tip: true" +
                       friction + " }\n")
@@ -220,10 +220,8 @@ BuiltScene build_scene(const problem::Problem& p) {
        << "    bulk_modulus_pa: " << num(fluid.bulk_modulus_pa()) << "\n"
        << "    viscosity_pa_s: " << num(fluid.viscosity_pa_s()) << "\n"
        << "    inlet { flow_rate_m2_s { "
-       << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(wing_q) + " }"
-                    : "constant: " + num(wing_q))
-       << (both ? " } }   # both wings: the total rate\n" : " } }   # one wing: half the total rate\n")
-       << "  }\n}\n";
+       << (ramp > 0 ? "ramp { t0: 0 v0: 0 t1: " + num(ramp) + " v1: " + num(wing_q) + " }" : "constant: " + num(wing_q))
+       << (both ? " } }   # both wings: the total rate\n" : " } }   # one wing: half the total rate\n") << "  }\n}\n";
 
   // The method the run will derive from this scene, listed in its header.
   scene::Scene built;

@@ -375,8 +375,8 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
                       std::isfinite(p.toughness) && std::isfinite(p.total_rate) && std::isfinite(p.effective_s) &&
                       std::isfinite(p.normal_stress) && std::isfinite(p.shear_stress) &&
                       std::isfinite(p.minimum_stress) && std::isfinite(p.viscosity);
-  if (!finite || !(out.cell > 0) || !(out.reach > 0) || !(p.notch > 0) || !(p.youngs_modulus > 0) ||
-      !(p.density > 0) || !(p.end_s > 0) || !(p.poisson_ratio >= 0 && p.poisson_ratio < 0.5) || !(p.toughness >= 0)) {
+  if (!finite || !(out.cell > 0) || !(out.reach > 0) || !(p.notch > 0) || !(p.youngs_modulus > 0) || !(p.density > 0) ||
+      !(p.end_s > 0) || !(p.poisson_ratio >= 0 && p.poisson_ratio < 0.5) || !(p.toughness >= 0)) {
     return refuse("the body, the rock, the cell or the crack is not valid yet (the scene's rules say what)");
   }
   return out;
@@ -425,12 +425,13 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
       derive_key(s, applied, "solid.mpm.fracture.propagate", "true",
                  "the rock at the well has a toughness: its crack grows where J reaches it");
     }
-    derive_key(s, applied, "solid.mpm.density_scaling", num(d.density_scaling),
-               "quasi-static: the scaled P-wave (" + approx(d.scaled_c) + " m/s) crosses the expected final "
-               "half-length " + approx(l_end) + " m in " + approx(100 * l_end / d.scaled_c / p.end_s) +
-                   "% of the injection (target 0.5%" +
-                   (d.settle ? "; with toughness, the settling wait may not cap the tip below its final speed" : "") +
-                   ")");
+    derive_key(
+        s, applied, "solid.mpm.density_scaling", num(d.density_scaling),
+        "quasi-static: the scaled P-wave (" + approx(d.scaled_c) +
+            " m/s) crosses the expected final "
+            "half-length " +
+            approx(l_end) + " m in " + approx(100 * l_end / d.scaled_c / p.end_s) + "% of the injection (target 0.5%" +
+            (d.settle ? "; with toughness, the settling wait may not cap the tip below its final speed" : "") + ")");
     derive_key(s, applied, "solid.mpm.damping.grid_alpha_per_s", num(d.damping),
                "critical for the body's lowest mode (" + approx(d.body_omega) + " rad/s over its reach " +
                    approx(physics->reach) + " m)" +

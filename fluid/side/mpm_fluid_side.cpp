@@ -14,6 +14,7 @@
 #include "hfmpm/output/side_frames.hpp"
 #include "hfmpm/proto/convert.hpp"
 #include "hfmpm/proto/scene_rules.hpp"
+#include "interface_watch.hpp"
 
 namespace hfmpm::fluid {
 namespace {
@@ -131,7 +132,22 @@ class MpmFluidSide final : public coupling::SideModel {
       for (const auto* solver : c.solvers()) report_retries(c.id, *solver, dt);
     }
     ++steps_;
+    if (config_.implicit_interface) {
+      std::uint64_t unsolved = 0, steps = 0;
+      double t = 0;
+      for (const auto& c : cracks_) {
+        for (const auto* solver : c.solvers()) {
+          unsolved += solver->interface_committed_above_bound();
+          steps += solver->steps();
+          t = std::max(t, solver->time());
+        }
+      }
+      if (auto message = interface_watch_.check(unsolved, steps, t))
+        notices_.push_back({"unsolved-interface", *message});
+    }
   }
+
+  std::vector<Notice> notices() const override { return notices_; }
 
   void publish(protocol::DataFrame& frame) override {
     auto* state = frame.mutable_fluid();  // a FluidState even when no crack holds fluid yet
@@ -374,6 +390,8 @@ class MpmFluidSide final : public coupling::SideModel {
   std::vector<FluidCrack> cracks_;
   bool received_ = false;
   std::uint64_t substeps_ = 0, steps_ = 0;  // fluid steps (all cracks) and coupled steps
+  InterfaceWatch interface_watch_;
+  std::vector<Notice> notices_;
   static constexpr int kReportedRetries = 20;
   int retries_reported_ = 0, above_reported_ = 0,
       junction_reported_ = 0;  // subcycled implicit steps written to the log (not checkpointed)

@@ -66,8 +66,9 @@ TEST(KgdScene, PhysicsOnlySceneFollowsTheMVertex) {
   Bounds bounds;
   bounds.volume_misfit = 1e-4;
   bounds.film = std::round(0.01 * opening * 1e6) / 1e6;  // the derived film: 2 significant digits, 1.4e-5 m
-  expect_ci_scene_follows("scenarios/kgd-physics-only-ci.scene", 2.5e-4,
-                          [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9, {}, bounds);
+  expect_ci_scene_follows(
+      "scenarios/kgd-physics-only-ci.scene", 2.5e-4, [](double t) { return m_vertex(1e7, 0.25, 0.01, 2.5e-4, t); }, 2e9,
+      {}, bounds);
 }
 
 // The case of the scene above with both wings modelled and the fluid entering

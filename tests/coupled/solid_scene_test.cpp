@@ -144,8 +144,10 @@ TEST(SolidScene, SneddonWithTheDefaultFacesHoldsEveryFacePoint) {
     worst_mouth = std::max(worst_mouth, std::abs(width.front() / mouth - 1));
     worst_k = std::max(worst_k, std::abs(h5.f64("/frames/" + frames[f] + "/tips/k1").front() / k1 - 1));
   }
-  std::printf("Sneddon with the default faces, 1.0-1.4 s: every face point within %.4f of the mouth opening; "
-              "mouth %.4f, K_I %.4f\n", worst_point, worst_mouth, worst_k);
+  std::printf(
+      "Sneddon with the default faces, 1.0-1.4 s: every face point within %.4f of the mouth opening; "
+      "mouth %.4f, K_I %.4f\n",
+      worst_point, worst_mouth, worst_k);
   EXPECT_LT(worst_point, 0.03);
   EXPECT_LT(worst_mouth, 0.02);
   EXPECT_LT(worst_k, 0.02);

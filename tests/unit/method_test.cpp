@@ -3,8 +3,8 @@
 // and the ones it leaves, against the numbers computed here from the rules.
 #include "hfmpm/coupling/method.hpp"
 
-#include <google/protobuf/text_format.h>
 #include <gmock/gmock.h>
+#include <google/protobuf/text_format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -27,7 +27,9 @@ scene::Scene parsed(const std::string& text) {
 
 // The lab viscosity-dominated KGD written with its physics only
 // (scenarios/kgd-physics-only-ci.scene).
-scene::Scene physics_only() { return parsed(hfmpm::test::read_file(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"))); }
+scene::Scene physics_only() {
+  return parsed(hfmpm::test::read_file(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene")));
+}
 
 const Setting* find(const std::vector<Setting>& settings, const std::string& key) {
   for (const auto& s : settings)
@@ -42,7 +44,7 @@ TEST(Method, ReadsTheFluidDrivenCracksPhysicsFromAScene) {
   EXPECT_DOUBLE_EQ(p->physics.youngs_modulus, 1e7);
   EXPECT_DOUBLE_EQ(p->physics.toughness, 100);
   EXPECT_DOUBLE_EQ(p->physics.viscosity, 0.01);
-  EXPECT_DOUBLE_EQ(p->physics.total_rate, 2.5e-4);  // an edge crack: twice the wing's 1.25e-4
+  EXPECT_DOUBLE_EQ(p->physics.total_rate, 2.5e-4);        // an edge crack: twice the wing's 1.25e-4
   EXPECT_NEAR(p->physics.effective_s, 5 - 0.025, 1e-12);  // a ramp over 0.05 s: half of it lost
   EXPECT_DOUBLE_EQ(p->physics.notch, 0.15);
   EXPECT_DOUBLE_EQ(p->physics.normal_stress, 1e5);
@@ -58,7 +60,8 @@ TEST(Method, DerivesTheVerifiedMethodForAPhysicsOnlyScene) {
   std::vector<Setting> applied;
   const scene::Scene s = with_method(physics_only(), &applied);
   const double e_prime = 1e7 / (1 - 0.0625);
-  const double km = std::sqrt(32 / std::numbers::pi) * 100 / std::pow(e_prime * e_prime * e_prime * 0.12 * 2.5e-4, 0.25);
+  const double km =
+      std::sqrt(32 / std::numbers::pi) * 100 / std::pow(e_prime * e_prime * e_prime * 0.12 * 2.5e-4, 0.25);
   EXPECT_NEAR(km, 0.0231, 1e-4);
   const Vertex m = m_vertex(e_prime, 0.01, 2.5e-4, 4.975);
   // Density scaling: the scaled P-wave crosses l in 0.5% of 5 s, rounded down to 2 digits.

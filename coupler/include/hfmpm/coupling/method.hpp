@@ -30,10 +30,10 @@ double toughness_number(double e_prime, double viscosity, double total_rate, dou
 // The physics of a fluid-driven crack that its method is derived from.
 struct Physics {
   double youngs_modulus = 0, poisson_ratio = 0, density = 0;  // the rock at the well
-  double toughness = 0;    // K_Ic, Pa m^0.5 (0: the zero-toughness limit)
-  double viscosity = 0;    // Pa s
-  double total_rate = 0;   // m^2/s into both wings, at the end
-  double end_s = 0;        // duration of the injection
+  double toughness = 0;                                       // K_Ic, Pa m^0.5 (0: the zero-toughness limit)
+  double viscosity = 0;                                       // Pa s
+  double total_rate = 0;                                      // m^2/s into both wings, at the end
+  double end_s = 0;                                           // duration of the injection
   double effective_s = 0;  // time the end rate takes to inject the volume (a ramp over t_r: end - t_r / 2)
   double notch = 0;        // m, the initial length of one wing
   // The in-situ stress, compressive magnitudes (Pa): normal and shear on the
@@ -79,8 +79,7 @@ struct Method {
   double tip_speed = 0;        // m/s, the tip's mean speed over the injection
   std::vector<Setting> settings;
 };
-Method derive(const Physics& physics, double cell, double reach, double chosen_scaling = 0,
-              double chosen_growth = 0);
+Method derive(const Physics& physics, double cell, double reach, double chosen_scaling = 0, double chosen_growth = 0);
 
 // The physics of a scene's fluid-driven crack: an MPM solid and an MPM fluid
 // with a flow-rate inlet. Empty, with `why_not` saying so, otherwise.
