@@ -341,7 +341,16 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
   p.normal_stress = sxx * nx * nx + syy * ny * ny + 2 * sxy * nx * ny;
   p.shear_stress = sxx * tx * nx + syy * ty * ny + sxy * (tx * ny + ty * nx);
   p.minimum_stress = 0.5 * (sxx + syy) - std::hypot(0.5 * (sxx - syy), sxy);
-  p.symmetric = straight && std::abs(p.shear_stress) <= 1e-9 * std::max(std::abs(sxx), std::abs(syy));
+  // Straight on by symmetry only in a homogeneous body: one material and one
+  // in-situ stress in every region (a layer of another rock beside the crack
+  // turns it).
+  bool homogeneous = true;
+  for (const auto& r : m.regions()) {
+    const auto& o = r.initial_stress();
+    homogeneous = homogeneous && r.material() == region->material() && o.xx_pa() == st.xx_pa() &&
+                  o.yy_pa() == st.yy_pa() && o.xy_pa() == st.xy_pa();
+  }
+  p.symmetric = straight && homogeneous && std::abs(p.shear_stress) <= 1e-9 * std::max(std::abs(sxx), std::abs(syy));
 
   out.cell = m.cell_size_m();
   // The body's box (regions; a layer spans the grid) and its reach from the
@@ -446,10 +455,11 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
                         : "the tip leads the fluid front by at most 2 steps, 2.5% of three notch lengths (" +
                               approx(3 * p.notch) + " m)");
     derive_key(s, applied, "solid.mpm.fracture.direction", p.symmetric ? "STRAIGHT" : "MAX_HOOP_STRESS",
-               p.symmetric ? "no in-situ shear on a straight notch: straight on by symmetry"
+               p.symmetric ? "a straight notch in a homogeneous body with no in-situ shear on it: straight on by "
+                             "symmetry"
                            : "the in-situ stress puts " + approx(std::abs(p.shear_stress)) +
-                                 " Pa of shear on the notch (or the crack is bent): the tips turn by maximum hoop "
-                                 "stress");
+                                 " Pa of shear on the notch, the crack is bent or the body is not homogeneous: the "
+                                 "tips turn by maximum hoop stress");
     if (s.fluid().mpm().lag() != scene::MpmFluid::ZERO_PRESSURE || !is_set(s, "fluid.mpm.lag")) {
       derive_key(s, applied, "solid.mpm.fracture.max_lag_cells", num(d.growth_cells),
                  "zero lag: the tip waits for the fluid front within a growth step");

@@ -188,6 +188,25 @@ TEST(Method, InclinedNotchUnderAnisotropicStressTurns) {
   EXPECT_NEAR(s.fluid().mpm().initial_fill().pressure_pa(), 112500, 1e-6);
 }
 
+// A layer of another rock beside the crack breaks the symmetry: the tips may turn.
+TEST(Method, LayeredBodyTurnsByHoopStress) {
+  scene::Scene written = physics_only();
+  auto& m = *written.mutable_solid()->mutable_mpm();
+  auto* soft = m.add_materials();
+  *soft = m.materials(0);
+  soft->set_name("soft");
+  soft->set_youngs_modulus_pa(5e6);
+  auto* layer = m.add_regions();
+  layer->set_material("soft");
+  layer->mutable_layer()->set_y_min_m(0.2);
+  layer->mutable_layer()->set_y_max_m(3.05);
+  *layer->mutable_initial_stress() = m.regions(0).initial_stress();
+  const auto p = physics_of(written);
+  ASSERT_TRUE(p);
+  EXPECT_FALSE(p->physics.symmetric);
+  EXPECT_EQ(with_method(written).solid().mpm().fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
+}
+
 // A dry scene gets the faces from the material and, with its in-situ
 // stress in equilibrium, that stress as the reference; nothing else.
 TEST(Method, DrySceneGetsTheFacesAndTheInSituReferenceOnly) {

@@ -39,8 +39,9 @@ struct Physics {
   // The in-situ stress, compressive magnitudes (Pa): normal and shear on the
   // notch's plane, and the smaller principal stress.
   double normal_stress = 0, shear_stress = 0, minimum_stress = 0;
-  // No in-situ shear on the notch and no shear traction on the body: the
-  // tips grow straight on by symmetry.
+  // A straight notch with no in-situ shear on it in a homogeneous body (one
+  // material and one in-situ stress in every region): the tips grow straight
+  // on by symmetry.
   bool symmetric = true;
 };
 
