@@ -41,23 +41,16 @@ BuiltScene build_scene(const problem::Problem& p) {
   const bool turning = std::abs(stresses.shear) > 1e-9 * std::max(stresses.xx, stresses.yy);
   const double cells_per_l = p.accuracy().cells_per_half_length(), box = p.accuracy().box_half_lengths();
 
-  // The physics the method is sized by (hfmpm/coupling/method.hpp): the run
-  // derives the same from the scene written below.
+  // The expected end sizes the geometry (the run derives the method from the
+  // scene written below, hfmpm/coupling/method.hpp).
   method::Physics physics;
   physics.youngs_modulus = e;
   physics.poisson_ratio = nu;
-  physics.density = rock.density_kg_m3();
   physics.toughness = rock.toughness_pa_sqrt_m();
   physics.viscosity = fluid.viscosity_pa_s();
   physics.total_rate = q;
-  physics.end_s = t_end;
   // A ramp over t_r injects the volume of a constant rate started t_r / 2 later.
   physics.effective_s = t_end - 0.5 * ramp;
-  physics.notch = p.notch_m();
-  physics.normal_stress = sigma_n;
-  physics.shear_stress = stresses.shear;
-  physics.minimum_stress = stresses.minimum;
-  physics.symmetric = !turning;
   const method::Expected expected = method::expect(physics);
 
   Derived d;
