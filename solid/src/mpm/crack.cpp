@@ -14,6 +14,14 @@ Vec2 left_normal(const Vec2& a, const Vec2& b) {
   return {-d.y(), d.x()};
 }
 
+// The mean of the left normals of point k's segments on the polyline x.
+Vec2 mean_normal(const std::vector<Vec2>& x, std::size_t k) {
+  Vec2 n = Vec2::Zero();
+  if (k > 0) n += left_normal(x[k - 1], x[k]);
+  if (k + 1 < x.size()) n += left_normal(x[k], x[k + 1]);
+  return n.normalized();
+}
+
 }  // namespace
 
 Crack::Crack(std::uint32_t id, const CrackSpec& spec)
@@ -84,12 +92,9 @@ void Crack::move_tip(bool at_end, const Vec2& position, const Vec2& reference) {
   reference_[k] = reference;
 }
 
-Vec2 Crack::normal(std::size_t k) const {
-  Vec2 n = Vec2::Zero();
-  if (k > 0) n += left_normal(plane_[k - 1], plane_[k]);
-  if (k + 1 < plane_.size()) n += left_normal(plane_[k], plane_[k + 1]);
-  return n.normalized();
-}
+Vec2 Crack::normal(std::size_t k) const { return mean_normal(plane_, k); }
+
+Vec2 Crack::opening_normal(std::size_t k) const { return mean_normal(reference_, k); }
 
 double Crack::tributary_length(std::size_t k) const {
   double l = 0;
@@ -107,7 +112,7 @@ void Crack::finish_contact(double dt) {
   }
 }
 
-double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(normal(k))); }
+double Crack::width(std::size_t k) const { return std::max(0.0, (above_[k] - below_[k]).dot(opening_normal(k))); }
 
 void Crack::receive_pressure(const std::vector<double>& pressure, const std::vector<double>& stiffness,
                              const std::vector<double>& width, std::size_t offset) {
