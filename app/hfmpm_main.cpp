@@ -8,6 +8,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "fluid_scene_rules.hpp"
@@ -66,7 +67,9 @@ constexpr const char* kUsage = R"(usage:
       cost: particles, grid nodes, the step, the steps to end_s, an estimated wall time.
 
 options:
-  --out DIR            output directory (default: hfmpm-out/SCENE_NAME)
+  --out DIR            output directory (default: hfmpm-out/SCENE_NAME); one live run per
+                       directory: a run, coupler or --restart into a directory another
+                       live run holds (DIR/.lock) is refused (exit 2) before writing in it
   --set KEY=VALUE      override one scene value, e.g. --set time.end_s=2
                        --set coupling.transport=TCP; repeated fields take [a, b];
                        one element of a list by index or name (docs/scenes.md):
@@ -127,6 +130,10 @@ int keygen(const std::vector<std::string>& args) {
 
 std::string describe(const coupling::RunState& state) {
   return "coupler pid " + std::to_string(state.pid) + " on " + state.host + ", started " + state.started_at;
+}
+
+std::string how_to_stop(const coupling::RunLockHolder& holder) {
+  return holder.pid > 0 ? "Ctrl-C, or kill " + std::to_string(holder.pid) : std::string("Ctrl-C");
 }
 
 // `hfmpm status DIR`; 0 when run.json was read, 2 for a bad command line.
@@ -262,6 +269,10 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       throw UsageError("more than one scene given ('" + scene_path + "' and '" + arg + "')");
   }
   std::shared_ptr<coupling::RestartPoint> restart_point;
+  // One live run per output directory, held until this process ends
+  // (run_state.hpp, RunLock): taken before anything in the directory is
+  // read for a restart or written.
+  std::optional<coupling::RunLock> lock;
   if (!restart.empty()) {
     if (command == "validate") throw UsageError("--restart is for 'hfmpm run' and 'hfmpm coupler'");
     if (!out.empty()) throw UsageError("--restart DIR continues in DIR; --out is not allowed with it");
@@ -269,6 +280,17 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       throw UsageError(
           "--set and --transport need the scene file: hfmpm run --restart DIR SCENE --set ... (the run's own scene "
           "and overrides; without SCENE the checkpoint's scene is used as it is)");
+    }
+    std::error_code exists_error;  // no directory: find_restart below says so
+    if (std::filesystem::is_directory(restart, exists_error)) {
+      try {
+        lock.emplace(restart);
+      } catch (const coupling::DirectoryInUse& e) {
+        std::cerr << "hfmpm: the run in " << restart << " is still running (" << describe(e.holder) << "; it holds "
+                  << e.lock_path << "); stop it first (" << how_to_stop(e.holder)
+                  << "), then restart: one live run per directory\n";
+        return 2;
+      }
     }
     // The run being continued must not be running; a coupler that was killed
     // left run.json at "running", which is recorded as stopped now.
@@ -378,6 +400,15 @@ int run(const std::string& command, const std::vector<std::string>& args) {
     throw UsageError("--bind is for 'hfmpm coupler'; 'hfmpm run' chooses its own endpoints");
   }
   options.output_dir = out.empty() ? "hfmpm-out/" + (scene.name().empty() ? std::string("run") : scene.name()) : out;
+  if (!lock) {
+    try {
+      lock.emplace(options.output_dir);
+    } catch (const coupling::DirectoryInUse& e) {
+      std::cerr << "hfmpm: " << e.what() << ": one live run per output directory; wait for it to end, stop it ("
+                << how_to_stop(e.holder) << "), or choose another --out\n";
+      return 2;
+    }
+  }
   options.scene_path = scene_path;
   options.overrides = overrides;
   options.inproc_factory = make_inproc_side;

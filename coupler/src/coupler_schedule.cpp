@@ -4,7 +4,44 @@
 
 #include "coupler_session.hpp"
 
+namespace hfmpm::coupling {
+
+double next_time_after(double next, double interval, double t) {
+  const double limit = t * (1 + 1e-12);
+  // The usual case: one interval (two after a long step), added as always.
+  constexpr int kAddedOneByOne = 8;
+  for (int i = 0; i < kAddedOneByOne && next <= limit; ++i) {
+    const double sum = next + interval;
+    if (!(sum > next)) break;  // no progress: the interval vanishes against `next` (or is not > 0)
+    next = sum;
+  }
+  if (next > limit) return next;
+  if (interval > 0) {
+    // Many intervals at once (a step far longer than the interval): whole ones.
+    const double jumped = next + (std::floor((limit - next) / interval) + 1) * interval;
+    if (jumped > limit && std::isfinite(jumped)) return jumped;
+  }
+  return std::nextafter(limit, detail::kInf);
+}
+
+std::string non_finite_report_fields(const google::protobuf::Message& report) {
+  std::string fields;
+  for (const auto& n : proto::non_finite_numbers(report)) {
+    if (n.path == "stable_dt" && n.value > 0) continue;  // +inf: the side sets no limit
+    std::ostringstream value;
+    value << n.value;
+    fields += (fields.empty() ? "" : ", ") + n.path + " = " + value.str();
+  }
+  return fields;
+}
+
+}  // namespace hfmpm::coupling
+
 namespace hfmpm::coupling::detail {
+
+constexpr const char* kFiniteReports =
+    "every number a side reports must be finite (stable_dt may also be +inf: no limit); the run stops here with its "
+    "output so far";
 
 void Coupler::handshake() {
   using Pending = std::function<bool(const Side&)>;
@@ -126,6 +163,10 @@ void Coupler::on_handshake_message(Side& side, const protocol::Envelope& envelop
     return;
   }
   if (envelope.has_ready() && !side.ready) {
+    if (const std::string bad = non_finite_report_fields(envelope.ready()); !bad.empty()) {
+      throw RunFailure{"the " + side.name + " side reported " + bad + " in its Ready (step " + std::to_string(step_) +
+                       "); " + kFiniteReports};
+    }
     side.ready = true;
     side.stable_dt = envelope.ready().stable_dt();
     side.stable_dt_limit = envelope.ready().stable_dt_limit().substr(0, 200);
@@ -330,7 +371,7 @@ void Coupler::step_loop(RunSummary& summary) {
     if (output) {  // dt_s: the step that led to this row
       history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
       ++frame;
-      while (next_output <= t_ * (1 + 1e-12)) next_output += interval;
+      next_output = next_time_after(next_output, interval, t_);
     }
     if (at_control && t_ < end * (1 - 1e-12)) dt = next_dt();
     if (checkpoint) {
@@ -339,7 +380,7 @@ void Coupler::step_loop(RunSummary& summary) {
           throw RunFailure{"the " + side.name + " side did not write the checkpoint" + at_step() + " it was asked for"};
         }
       }
-      while (schedule.next_checkpoint <= t_ * (1 + 1e-12)) schedule.next_checkpoint += checkpoint_interval;
+      schedule.next_checkpoint = next_time_after(schedule.next_checkpoint, checkpoint_interval, t_);
       // Both sides have theirs on disk: the coupler's file completes the checkpoint.
       save_checkpoint(schedule, summary);
       log_.file_only("checkpoint " + checkpoint_dir + " complete (t = " + std::to_string(t_) + " s)");
@@ -471,6 +512,14 @@ void Coupler::await_reports(std::uint64_t step, double t, double timeout_s) {
     auto& [side, envelope] = *message;
     if (!envelope.has_step_report() || side->report) unexpected(*side, envelope, "StepReport");
     const auto& report = envelope.step_report();
+    // Before anything of it is used: a NaN or an infinity would otherwise go
+    // on into history.csv, run.json, the energy check and the next step.
+    if (const std::string bad = non_finite_report_fields(report); !bad.empty()) {
+      std::ostringstream out;
+      out << "the " << side->name << " side reported " << bad << " in its StepReport for step " << step << " (t = " << t
+          << " s); " << kFiniteReports;
+      throw RunFailure{out.str()};
+    }
     if (report.step() != step || report.t() != t) {
       std::ostringstream out;
       out << std::setprecision(17) << "the " << side->name << " side reports step " << report.step()

@@ -1,9 +1,14 @@
 // Is the run in a directory still going (run_state.hpp)?
 #include "hfmpm/coupling/run_state.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <map>
@@ -73,16 +78,22 @@ std::string get(const Fields& fields, const std::string& key) {
   return it == fields.end() ? std::string() : unquote(it->second);
 }
 
+std::string fields_text(const Fields& fields) {
+  std::ostringstream out;
+  out << "{\n";
+  std::size_t i = 0;
+  for (const auto& [key, value] : fields) {
+    out << "  \"" << key << "\": " << value << (++i < fields.size() ? ",\n" : "\n");
+  }
+  out << "}\n";
+  return out.str();
+}
+
 void write_fields(const std::string& path, const Fields& fields) {
   const std::string tmp = path + ".check";
   {
     std::ofstream out(tmp);
-    out << "{\n";
-    std::size_t i = 0;
-    for (const auto& [key, value] : fields) {
-      out << "  \"" << key << "\": " << value << (++i < fields.size() ? ",\n" : "\n");
-    }
-    out << "}\n";
+    out << fields_text(fields);
     if (!out.flush()) throw std::runtime_error("cannot write " + tmp);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot replace " + path);
@@ -176,6 +187,61 @@ RunState check_run_state(const std::string& run_dir, bool record) {
     write_fields(path, fields);
   }
   return state;
+}
+
+std::string describe(const RunLockHolder& holder) {
+  if (holder.pid <= 0) return "an hfmpm that is starting and has not yet written its pid";
+  return "coupler pid " + std::to_string(holder.pid) + " on " + holder.host + ", started " + holder.started_at;
+}
+
+RunLock::RunLock(const std::string& dir) : path_(dir + "/" + kRunLockFile) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir)) {
+    throw std::runtime_error("cannot create the output directory '" + dir + "'" +
+                             (error ? ": " + error.message() : std::string(": a file of that name is in the way")));
+  }
+  // O_CREAT without O_TRUNC: a live holder's file is not touched before flock says it is free.
+  fd_ = open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw std::runtime_error("cannot open the run lock '" + path_ + "': " + std::strerror(errno));
+  if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int why = errno;
+    close(fd_);
+    fd_ = -1;
+    if (why != EWOULDBLOCK) {
+      throw std::runtime_error("cannot lock '" + path_ + "' (flock: " + std::strerror(why) +
+                               "); hfmpm needs a file system with flock(2) for its output directory, so that two "
+                               "runs cannot write into one: choose another --out");
+    }
+    RunLockHolder holder;
+    try {
+      const Fields fields = read_fields(path_);
+      holder.pid = std::stol(get(fields, "pid"));
+      holder.host = get(fields, "host");
+      holder.started_at = get(fields, "started_at");
+    } catch (const std::exception&) {
+      holder = {};  // taken a moment ago, its holder's name not yet written
+    }
+    throw DirectoryInUse(
+        "the directory '" + dir + "' is in use by another run (" + describe(holder) + "; it holds " + path_ + ")",
+        holder, path_);
+  }
+  Fields fields;
+  fields["pid"] = std::to_string(getpid());
+  fields["host"] = quote(host_name());
+  fields["started_at"] = quote(detail::utc_now());
+  const std::string bytes = fields_text(fields);
+  // In place, under the lock (a rename would give the file a new inode, not covered by this lock).
+  if (ftruncate(fd_, 0) != 0 || pwrite(fd_, bytes.data(), bytes.size(), 0) != static_cast<ssize_t>(bytes.size())) {
+    const int why = errno;
+    close(fd_);
+    fd_ = -1;
+    throw std::runtime_error("cannot write the run lock '" + path_ + "': " + std::strerror(why));
+  }
+}
+
+RunLock::~RunLock() {
+  if (fd_ >= 0) close(fd_);
 }
 
 }  // namespace hfmpm::coupling

@@ -29,16 +29,36 @@ void check_time(Checker& c, const scene::Scene& s) {
   if (s.time().max_steps() == 0) c.bad("time.max_steps", "0", "an integer >= 1");
   const double end = s.time().end_s();
   const bool end_valid = s.time().has_end_s() && std::isfinite(end) && end > 0;
-  const double upper = end_valid ? end : kInf;  // NOLINT(bugprone-narrowing-conversions): clang-tidy 14 misreads inf
-  c.range("output.interval_s", s.output().interval_s(), 0, upper, false, "s, 0 for end_s / 100");
-  c.range("output.checkpoint_interval_s", s.output().checkpoint_interval_s(), 0, upper, false,
-          "s, 0 for no checkpoints");
+  // Each is a schedule of times a multiple of it apart, up to end_s. Its
+  // floor is end_s / kMaxRunSteps (min_time_interval), the step of a run of
+  // the most steps allowed: a shorter interval cannot give more than one row
+  // (or checkpoint) per step, and one far below end_s vanishes against the
+  // time it is added to (1 + 1e-300 is 1, which hung the coupler).
+  auto interval = [&](const std::string& key, double v, const std::string& zero) {
+    if (v == 0) return;
+    if (!end_valid) {  // end_s's own rule reports it; the interval is checked once end_s is valid
+      c.range(key, v, 0, kInf, false, "s, 0 for " + zero);
+      return;
+    }
+    const double shortest = min_time_interval(end);
+    if (std::isfinite(v) && v >= shortest && v <= end) return;
+    c.bad(key, text(v),
+          "0 (" + zero + ") or a finite value from " + text(shortest) + " to " + text(end) +
+              " s (time.end_s; at least time.end_s / " + text(kMaxRunSteps) +
+              ", the step of a run of the most steps allowed: a shorter interval gives no " +
+              "more than one per step)");
+  };
+  interval("output.interval_s", s.output().interval_s(), "end_s / 100");
+  interval("output.checkpoint_interval_s", s.output().checkpoint_interval_s(), "no checkpoints");
 }
 
 // Checkpoints need both sides to write them: each side's rules say whether
 // its model in this scene does (SideSceneRules::checkpoint_refusal).
 void check_checkpoints(Checker& c, const scene::Scene& s, const SceneRules& rules) {
-  if (!(s.output().checkpoint_interval_s() > 0)) return;
+  const double interval = s.output().checkpoint_interval_s(), end = s.time().end_s();
+  if (!(interval > 0)) return;
+  // An interval that check_time refuses is reported once, there.
+  if (std::isfinite(end) && end > 0 && !(interval >= min_time_interval(end) && interval <= end)) return;
   std::string refusals;
   auto ask = [&](const SideSceneRules& side) {
     if (!side.checkpoint_refusal) return;

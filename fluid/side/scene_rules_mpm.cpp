@@ -2,7 +2,9 @@
 // which of the solid's cracks hold fluid.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "fluid_scene_rules.hpp"
@@ -41,6 +43,40 @@ std::vector<SceneCrack> scene_cracks(const scene::Solid& solid) {
   return out;
 }
 
+// The pressure the MPM fluid admits before it fails a step, as a multiple of
+// its bulk modulus (FluidSolver::kCompressionLimit, fluid/include/hfmpm/fluid/mpm/solver.hpp).
+constexpr double kAdmittedPressureOverK = 100;
+
+// Each constant finite on its own can still give a quantity the fluid
+// computes with that is not: K = 1e308 passed every rule and ran, its
+// pressure limit 100 K overflowing to inf and the inlet pressure with it.
+// What the fluid derives from K, rho and c before it steps must be finite:
+// its sound speed sqrt(K / rho) (the explicit step cfl h / c_s), the largest
+// pressure it admits, 100 K, and that pressure over tait_c (the implicit
+// interface's compressibility term K + p / c).
+void check_derived_constants(Checker& c, const scene::MpmFluid& f, const std::string& key) {
+  const double K = f.bulk_modulus_pa(), rho = f.density_kg_m3(), tait = f.tait_c();
+  auto valid = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!valid(K) || !valid(rho) || !valid(tait)) return;  // reported by their own rules
+  const double speed = std::sqrt(K / rho);
+  const double admitted = kAdmittedPressureOverK * K;
+  const std::string values =
+      "bulk_modulus_pa = " + text(K) + ", density_kg_m3 = " + text(rho) + ", tait_c = " + text(tait);
+  if (!(std::isfinite(speed) && speed > 0)) {
+    c.bad(key + "bulk_modulus_pa", text(K),
+          "a bulk modulus and density whose sound speed sqrt(bulk_modulus_pa / density_kg_m3) is a finite number > 0 "
+          "(m/s; the fluid's explicit step is cfl h / that): here " +
+              text(speed) + " m/s from " + values);
+  } else if (!std::isfinite(admitted) || !std::isfinite(admitted / tait)) {
+    c.bad(key + "bulk_modulus_pa", text(K),
+          "a bulk modulus with the pressure the fluid admits, " + text(kAdmittedPressureOverK) +
+              " x bulk_modulus_pa, and that pressure / tait_c finite (the implicit interface's term K + p / tait_c): "
+              "at most " +
+              text(std::numeric_limits<double>::max() / kAdmittedPressureOverK * std::min(1.0, tait), 3) +
+              " Pa with tait_c = " + text(tait) + " (liquids: 1e9 to 1e10 Pa)");
+  }
+}
+
 }  // namespace
 
 void check_mpm_fluid(Checker& c, const scene::Scene& s) {
@@ -49,6 +85,7 @@ void check_mpm_fluid(Checker& c, const scene::Scene& s) {
   c.positive(key + "density_kg_m3", f.density_kg_m3(), "kg/m^3");
   c.positive(key + "bulk_modulus_pa", f.bulk_modulus_pa(), "Pa");
   c.positive(key + "tait_c", f.tait_c(), "dimensionless; 0.0894 for water");
+  check_derived_constants(c, f, key);
   c.non_negative(key + "viscosity_pa_s", f.viscosity_pa_s(), "Pa s");
   c.range(key + "cfl", f.cfl(), 0, 1, true, "dimensionless");
   c.non_negative(key + "particle_length_m", f.particle_length_m(), "m; 0 = half the mouth element");

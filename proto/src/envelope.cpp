@@ -5,12 +5,49 @@
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 #include <google/protobuf/unknown_field_set.h>
 
+#include <cmath>
 #include <cstdio>
 
 #include <vector>
 
 namespace hfmpm::proto {
 namespace {
+
+void collect_non_finite(const google::protobuf::Message& message, const std::string& prefix,
+                        std::vector<NonFinite>& out) {
+  namespace pb = google::protobuf;
+  const auto* reflection = message.GetReflection();
+  std::vector<const pb::FieldDescriptor*> fields;
+  reflection->ListFields(message, &fields);  // proto3: NaN and inf are not 0, so they are listed
+  for (const auto* field : fields) {
+    const std::string key = prefix + field->name();
+    const int count = field->is_repeated() ? reflection->FieldSize(message, field) : 1;
+    for (int i = 0; i < count; ++i) {
+      const std::string k = field->is_repeated() ? key + "[" + std::to_string(i) + "]" : key;
+      switch (field->cpp_type()) {
+        case pb::FieldDescriptor::CPPTYPE_DOUBLE: {
+          const double v = field->is_repeated() ? reflection->GetRepeatedDouble(message, field, i)
+                                                : reflection->GetDouble(message, field);
+          if (!std::isfinite(v)) out.push_back({k, v});
+          break;
+        }
+        case pb::FieldDescriptor::CPPTYPE_FLOAT: {
+          const double v = field->is_repeated() ? reflection->GetRepeatedFloat(message, field, i)
+                                                : reflection->GetFloat(message, field);
+          if (!std::isfinite(v)) out.push_back({k, v});
+          break;
+        }
+        case pb::FieldDescriptor::CPPTYPE_MESSAGE:
+          collect_non_finite(field->is_repeated() ? reflection->GetRepeatedMessage(message, field, i)
+                                                  : reflection->GetMessage(message, field),
+                             k + ".", out);
+          break;
+        default:
+          break;
+      }
+    }
+  }
+}
 
 // True if `message` or any message set inside it carries unknown fields.
 bool has_unknown_fields(const google::protobuf::Message& message) {
@@ -54,6 +91,12 @@ protocol::Envelope decode(const void* data, std::size_t size, std::string_view f
                         std::to_string(size) + " bytes)");
   }
   return envelope;
+}
+
+std::vector<NonFinite> non_finite_numbers(const google::protobuf::Message& message) {
+  std::vector<NonFinite> out;
+  collect_non_finite(message, "", out);
+  return out;
 }
 
 std::string_view body_name(const protocol::Envelope& envelope) {

@@ -2,9 +2,9 @@
 // (hfmpm/proto/scene_rules.hpp).
 #include "hfmpm/proto/scene_rules.hpp"
 
-#include <google/protobuf/descriptor.h>
-
 #include <set>
+
+#include "hfmpm/proto/envelope.hpp"
 
 namespace hfmpm::proto {
 
@@ -69,42 +69,11 @@ namespace {
 
 // Every double and float field set anywhere in `message` (repeated and
 // nested ones included) that is NaN or infinite, as problems keyed by its path
-// ("solid.mpm.cracks[0].x_m[1]"). By reflection, so a new field is covered
-// without code here.
-void check_finite(Checker& c, const google::protobuf::Message& message, const std::string& prefix) {
-  namespace pb = google::protobuf;
-  const auto* reflection = message.GetReflection();
-  std::vector<const pb::FieldDescriptor*> fields;
-  reflection->ListFields(message, &fields);
-  const std::string allowed = "a finite number: every number in a scene must be finite";
-  for (const auto* field : fields) {
-    const std::string key = prefix + field->name();
-    const int count = field->is_repeated() ? reflection->FieldSize(message, field) : 1;
-    for (int i = 0; i < count; ++i) {
-      const std::string k = field->is_repeated() ? key + "[" + std::to_string(i) + "]" : key;
-      switch (field->cpp_type()) {
-        case pb::FieldDescriptor::CPPTYPE_DOUBLE: {
-          const double v = field->is_repeated() ? reflection->GetRepeatedDouble(message, field, i)
-                                                : reflection->GetDouble(message, field);
-          if (!std::isfinite(v)) c.bad(k, text(v), allowed);
-          break;
-        }
-        case pb::FieldDescriptor::CPPTYPE_FLOAT: {
-          const double v = field->is_repeated() ? reflection->GetRepeatedFloat(message, field, i)
-                                                : reflection->GetFloat(message, field);
-          if (!std::isfinite(v)) c.bad(k, text(v), allowed);
-          break;
-        }
-        case pb::FieldDescriptor::CPPTYPE_MESSAGE:
-          check_finite(c,
-                       field->is_repeated() ? reflection->GetRepeatedMessage(message, field, i)
-                                            : reflection->GetMessage(message, field),
-                       k + ".");
-          break;
-        default:
-          break;
-      }
-    }
+// ("solid.mpm.cracks[0].x_m[1]"); non_finite_numbers finds them by reflection,
+// so a new field is covered without code here.
+void check_finite(Checker& c, const google::protobuf::Message& message) {
+  for (const auto& n : non_finite_numbers(message)) {
+    c.bad(n.path, text(n.value), "a finite number: every number in a scene must be finite");
   }
 }
 
@@ -112,7 +81,7 @@ void check_finite(Checker& c, const google::protobuf::Message& message, const st
 
 std::vector<SceneProblem> finite_first(std::vector<SceneProblem> problems, const google::protobuf::Message& message) {
   Checker finite;
-  check_finite(finite, message, "");
+  check_finite(finite, message);
   const auto not_finite = finite.take();
   if (not_finite.empty()) return problems;
   std::set<std::string> keys;

@@ -240,6 +240,90 @@ TEST(Failure, AKilledCouplerIsRecordedByTheNextHfmpm) {
   EXPECT_NE(none.err.find("no run.json in this directory"), std::string::npos) << none.err;
 }
 
+// Two runs into one directory used to mix their rows in history.csv and
+// damage each other's files. The second (run, coupler, restart) is refused
+// before it writes anything there, naming the live run; the first goes on.
+TEST(Failure, OneLiveRunPerOutputDirectory) {
+  const auto out = scratch_dir("one-live-run");
+  const auto elsewhere = scratch_dir("second-run");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  write_file(elsewhere + "/scene.scene", prescribed_scene(0.1, 0.01));
+  Process first({bin("hfmpm"), "run", scene, "--out", out, "--quiet"});
+  for (int i = 0; i < 500 && history_rows(out) < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_GE(history_rows(out), 3u);
+  const std::string pid = std::to_string(first.pid());
+  const std::string manifest = read_file(out + "/run.json");
+  const std::string lock = read_file(out + "/.lock");
+  EXPECT_NE(lock.find("\"pid\": " + pid + ","), std::string::npos) << lock;
+  const auto scene_json_written = std::filesystem::last_write_time(out + "/scene.json");
+  std::set<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(out)) files.insert(entry.path().filename().string());
+
+  const std::string busy = "hfmpm: the directory '" + out + "' is in use by another run (coupler pid " + pid + " on ";
+  const auto second = run({bin("hfmpm"), "run", elsewhere + "/scene.scene", "--out", out, "--quiet"}, 20);
+  EXPECT_EQ(second.exit_code, 2) << second.err;
+  EXPECT_NE(second.err.find(busy), std::string::npos) << second.err;
+  EXPECT_NE(second.err.find("it holds " + out +
+                            "/.lock): one live run per output directory; wait for it to end, "
+                            "stop it (Ctrl-C, or kill " +
+                            pid + "), or choose another --out"),
+            std::string::npos)
+      << second.err;
+  const auto coupler = run({bin("hfmpm"), "coupler", elsewhere + "/scene.scene", "--bind", "tcp://127.0.0.1:*",
+                            "--insecure-tcp", "--out", out, "--quiet"},
+                           20);
+  EXPECT_EQ(coupler.exit_code, 2) << coupler.err;
+  EXPECT_NE(coupler.err.find(busy), std::string::npos) << coupler.err;
+  const auto restart = run({bin("hfmpm"), "run", "--restart", out, "--quiet"}, 20);
+  EXPECT_EQ(restart.exit_code, 2) << restart.err;
+  EXPECT_NE(restart.err.find("the run in " + out + " is still running (coupler pid " + pid + " on "), std::string::npos)
+      << restart.err;
+
+  // Nothing of the refused ones in the directory; the first runs on.
+  EXPECT_TRUE(first.running());
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "run_id"), json_string(manifest, "run_id"));
+  EXPECT_EQ(read_file(out + "/.lock"), lock);
+  EXPECT_EQ(std::filesystem::last_write_time(out + "/scene.json"), scene_json_written);
+  std::set<std::string> files_after;
+  for (const auto& entry : std::filesystem::directory_iterator(out)) {
+    files_after.insert(entry.path().filename().string());
+  }
+  EXPECT_EQ(files_after, files);
+  const std::size_t rows = history_rows(out);
+  ASSERT_EQ(kill(first.pid(), SIGTERM), 0);
+  ASSERT_TRUE(first.wait(20));
+  EXPECT_EQ(first.exit_code(), 128 + SIGTERM) << first.err();
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "interrupted");
+  // One run's rows: one header, no step before the one above it (the row the
+  // interrupt writes repeats the last output row's step when it stops there).
+  const Csv history = read_csv(out + "/history.csv");
+  EXPECT_GE(history.rows.size(), rows);
+  const auto steps = history.values("step");
+  for (std::size_t i = 1; i < steps.size(); ++i) ASSERT_GE(steps[i], steps[i - 1]) << "row " << i;
+}
+
+// The kernel drops a killed process's flock: the lock file it leaves, still
+// naming it, does not block the next run.
+TEST(Failure, ALockLeftByAKilledRunDoesNotBlock) {
+  const auto out = scratch_dir("lock-left");
+  const std::string scene = out + "/scene.scene";
+  write_file(scene, prescribed_scene(100.0, 0.01));
+  Process killed({bin("hfmpm"), "run", scene, "--out", out, "--quiet"});
+  for (int i = 0; i < 500 && history_rows(out) < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  ASSERT_GE(history_rows(out), 3u);
+  const std::string pid = std::to_string(killed.pid());
+  ASSERT_EQ(kill(killed.pid(), SIGKILL), 0);
+  ASSERT_TRUE(killed.wait(5));
+  EXPECT_NE(read_file(out + "/.lock").find("\"pid\": " + pid + ","), std::string::npos) << "left behind, naming it";
+
+  write_file(scene, prescribed_scene(0.1, 0.01));
+  const auto next = run({bin("hfmpm"), "run", scene, "--out", out, "--quiet"}, 60);
+  EXPECT_EQ(next.exit_code, 0) << next.err;
+  EXPECT_EQ(json_string(read_file(out + "/run.json"), "status"), "completed");
+  EXPECT_EQ(read_file(out + "/.lock").find("\"pid\": " + pid + ","), std::string::npos) << "the next run's name now";
+}
+
 // Sides started by hand (not children of the coupler) notice its silence.
 TEST(Failure, HandStartedSidesExitWhenTheCouplerGoesSilent) {
   const auto out = scratch_dir("silent");

@@ -82,4 +82,13 @@ struct RunSummary {
 // Runs a validated scene. Never throws for run failures: they are in the summary.
 RunSummary run_coupled(const scene::Scene& scene, const RunOptions& options);
 
+// Every number a side reports (a StepReport or a Ready: t, stable_dt,
+// compute_s, exchange_s and every diagnostic) must be finite; stable_dt may
+// also be +inf ("no limit", protocol.proto). Returns the fields that break
+// it with their values ("diagnostics.inlet_pressure = nan, compute_s =
+// inf"), or "" if none does. The coupler fails the run with them, naming the
+// side and the step, before the report reaches a history row (the rows so far
+// are kept).
+std::string non_finite_report_fields(const google::protobuf::Message& report);
+
 }  // namespace hfmpm::coupling

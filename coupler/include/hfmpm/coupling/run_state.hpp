@@ -9,7 +9,9 @@
 
 #include <sys/types.h>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace hfmpm::coupling {
 
@@ -40,5 +42,48 @@ struct RunState {
 // status kStoppedWithoutFinishing in run.json (the status it had goes to
 // "status_before_check", and "stopped_found_at" says when it was noticed).
 RunState check_run_state(const std::string& run_dir, bool record);
+
+// One live run per output directory (docs/reliability.md, "One live run per
+// output directory"): `hfmpm run` and `hfmpm coupler` (with or without
+// --restart) hold DIR/.lock with flock(2) for the whole run. The kernel
+// releases it when the process ends in any way (kill -9 included), so a lock
+// file left by a dead run does not block; the file stays and names its last
+// holder. The descriptor is close-on-exec: the sides a coupler starts never
+// hold it.
+inline constexpr const char* kRunLockFile = ".lock";
+
+// Who holds (or last held) a directory's lock, as its lock file says.
+struct RunLockHolder {
+  long pid = 0;  // 0 while the holder has not yet written its name
+  std::string host, started_at;
+};
+
+// The directory's lock is held by a live process (what() names it and the directory).
+struct DirectoryInUse : std::runtime_error {
+  DirectoryInUse(const std::string& message, RunLockHolder by, std::string file)
+      : std::runtime_error(message), holder(std::move(by)), lock_path(std::move(file)) {}
+  RunLockHolder holder;
+  std::string lock_path;
+};
+
+// "coupler pid N on HOST, started T" (as `hfmpm status` names a running coupler).
+std::string describe(const RunLockHolder& holder);
+
+class RunLock {
+ public:
+  // Creates DIR if needed and takes DIR/.lock, writing this process's pid,
+  // host and start time into it. Throws DirectoryInUse (nothing in DIR
+  // written) if a live process holds it, std::runtime_error if DIR or the
+  // lock cannot be made or the file system has no flock.
+  explicit RunLock(const std::string& dir);
+  ~RunLock();  // releases the lock; the file stays
+  RunLock(const RunLock&) = delete;
+  RunLock& operator=(const RunLock&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+};
 
 }  // namespace hfmpm::coupling

@@ -58,8 +58,22 @@ std::vector<SceneProblem> validate(const scene::Scene& scene, const SceneRules& 
 // Most steps a run may need to reach time.end_s (validation and the coupler).
 inline constexpr double kMaxRunSteps = 1e9;
 
+// The shortest output.interval_s and output.checkpoint_interval_s allowed:
+// end_s / kMaxRunSteps, the step of a run of the most steps allowed (a shorter
+// interval gives no more than a row, or a checkpoint, per step).
+inline double min_time_interval(double end_s) { return end_s / kMaxRunSteps; }
+
 // Effective values used by the coupler.
 double output_interval(const scene::Scene& scene);
+
+// The next time of a schedule (output rows, checkpoints) after the time t:
+// `next` advanced by whole intervals until it lies beyond t (t (1 + 1e-12),
+// the step loop's tolerance). One interval is added at a time as long as a
+// few reach past t (the sums a run has always made: rows at the same times
+// as before); more are taken at once, counted with floor; and the time
+// returned is past t whatever the interval (one below t's precision, 0 or
+// NaN gives the next double above t): no loop that cannot progress.
+double next_time_after(double next, double interval, double t);
 
 // The scene with every unset scalar that has a default set to it, in every
 // block present (and time, output and coupling, whose every key has one):

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "hfmpm/protocol.pb.h"
 
@@ -31,6 +32,18 @@ std::string encode(const protocol::Envelope& envelope);
 // Parses one frame; throws ProtocolError naming `from` if the bytes are not an
 // Envelope with a body, or carry fields this version does not know.
 protocol::Envelope decode(const void* data, std::size_t size, std::string_view from);
+
+// A double or float set in a message that is NaN or infinite: its path
+// from the message ("diagnostics.inlet_pressure", "cracks[0].x_m[1]") and value.
+struct NonFinite {
+  std::string path;
+  double value = 0;
+};
+// Every one in `message`, nested and repeated fields included, in field
+// order. By reflection, so a field added later is covered without code here
+// (the scene's rule "every number is finite", the coupler's check of what a
+// side reports).
+std::vector<NonFinite> non_finite_numbers(const google::protobuf::Message& message);
 
 // "hello", "step_command", ... or "empty" for an envelope without a body.
 std::string_view body_name(const protocol::Envelope& envelope);
