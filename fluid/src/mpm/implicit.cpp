@@ -27,8 +27,8 @@
 // ends seeing the new widths and the no-tension cut), so Newton's method
 // with one finite-difference Jacobian converges in a few iterations. P_e
 // touches only the residuals of elements a few away, so the Jacobian is
-// banded: it is built from one trial per colour (elements kColours apart
-// perturbed together) and factorised sparse.
+// banded: it is built from one trial per colour (elements 2 jacobian_reach + 1 apart,
+// perturbed together; implicit_detail.hpp) and factorised sparse.
 //
 // For an incompressible fluid P is the Lagrange multiplier that makes the
 // crack's new volume hold the fluid it received; for a compressible one the

@@ -123,6 +123,7 @@ std::vector<double> FluidSolver::implicit_substep(double h, double tau, bool las
       std::vector<std::vector<std::pair<std::size_t, double>>> dg(elements);  // rows of dg/dP
       double norm = min_form(P, g, phi);  // falls with every accepted step: the last iterate is the best
       std::vector<double> probe, back;
+      const std::size_t reach = jacobian_reach(wall_band_), colours = 2 * reach + 1;
       // One Newton solve from P. careful: the Jacobian by central differences
       // and with its row sums over the filled elements measured by one
       // uniform probe (see "Why a careful Jacobian" below).
@@ -130,15 +131,15 @@ std::vector<double> FluidSolver::implicit_substep(double h, double tau, bool las
         for (int it = 0; it < 40 && max_abs(phi) > tolerance; ++it) {
           ++interface_iterations_;
           for (auto& row : dg) row.clear();
-          for (std::size_t colour = 0; colour < kColours && colour < elements; ++colour) {
+          for (std::size_t colour = 0; colour < colours && colour < elements; ++colour) {
             // A forward difference, or a backward one where the forward probe
             // squeezes a particle to nothing (P lies at the edge of the feasible
             // set); careful: central where both probes hold.
             probe = P;
-            for (std::size_t e = colour; e < elements; e += kColours) probe[e] += delta;
+            for (std::size_t e = colour; e < elements; e += colours) probe[e] += delta;
             const bool forward = interface_trial(probe, h, trial, g_probe);
             back = P;
-            for (std::size_t e = colour; e < elements; e += kColours) back[e] = std::max(0.0, P[e] - delta);
+            for (std::size_t e = colour; e < elements; e += colours) back[e] = std::max(0.0, P[e] - delta);
             const bool backward = (careful || !forward) && interface_trial(back, h, trial, g_back);
             if (!forward && !backward) fail("it turns a particle inside out while probing");
             if (!forward) {
@@ -147,9 +148,9 @@ std::vector<double> FluidSolver::implicit_substep(double h, double tau, bool las
             }
             const bool central = forward && backward;
             for (std::size_t row = 0; row < elements; ++row) {
-              // The perturbed element of this colour nearest the row (one lies within kReach).
-              const std::size_t r = (row % kColours + kColours - colour) % kColours;
-              const std::size_t col = r <= kReach ? row - r : row + (kColours - r);
+              // The perturbed element of this colour nearest the row (one lies within reach).
+              const std::size_t r = (row % colours + colours - colour) % colours;
+              const std::size_t col = r <= reach ? row - r : row + (colours - r);
               if (col >= elements) continue;
               const double moved = central ? probe[col] - back[col] : probe[col] - P[col];
               if (moved == 0) continue;
