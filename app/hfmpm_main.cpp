@@ -17,6 +17,7 @@
 #include "hfmpm/coupling/run_state.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "hfmpm/coupling/stop_signals.hpp"
+#include "hfmpm/output/checkpoint_file.hpp"
 #include "hfmpm/runtime/curve.hpp"
 #include "hfmpm/solid/mpm/solver.hpp"
 #include "mpm_fluid_side.hpp"
@@ -317,10 +318,20 @@ int run(const std::string& command, const std::vector<std::string>& args) {
       // No readable run.json: find_restart below says what is missing.
     }
     try {
-      restart_point = std::make_shared<coupling::RestartPoint>(coupling::find_restart(restart));
+      // Each side's file is checked here too, so that a damaged one sends the restart to the
+      // checkpoint before it instead of failing the side that reads it.
+      restart_point = std::make_shared<coupling::RestartPoint>(
+          coupling::find_restart(restart, [](const std::string& path) { output::verify_checkpoint(path); }));
     } catch (const coupling::RestartError& e) {
       std::cerr << "hfmpm: " << e.what() << "\n";
       return 2;
+    }
+    for (const auto& damaged : restart_point->damaged) {
+      std::cerr << "hfmpm: warning: passing over the damaged checkpoint " << damaged << "\n";
+    }
+    if (!restart_point->damaged.empty()) {
+      std::cerr << "hfmpm: continuing from the complete checkpoint before it, " << restart_point->directory << " (step "
+                << restart_point->state.step() << ")\n";
     }
   }
   if (scene_path.empty() && !restart_point) throw UsageError("no scene file given");

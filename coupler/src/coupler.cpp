@@ -194,13 +194,17 @@ void Coupler::prepare() {
     const auto& r = *options_.restart;
     step_ = r.state.step();
     t_ = r.state.t();
-    truncate_history(output_dir_ + "/history.csv", step_);
-    history_ = std::make_unique<History>(output_dir_ + "/history.csv", true);
+    const auto last_row = truncate_history(output_dir_ + "/history.csv", step_);
+    history_ = std::make_unique<History>(output_dir_ + "/history.csv", true, last_row);
     manifest_.set("restarted_from", r.directory);
     manifest_.set_number("restart_step", static_cast<double>(step_));
     manifest_.set_number("restart_time_s", t_);
     manifest_.set("restarted_run_id", r.state.run_id());
     if (!options_.previous_status.empty()) manifest_.set("previous_status", options_.previous_status);
+    for (const auto& damaged : r.damaged) {
+      manifest_.append("damaged_checkpoints", damaged);
+      log_.file_only("passed over the damaged checkpoint " + damaged);
+    }
     log_("restarting from " + r.directory + " (step " + std::to_string(step_) + ", t = " + std::to_string(t_) + " s)");
   } else {
     history_ = std::make_unique<History>(output_dir_ + "/history.csv");  // header now: always readable

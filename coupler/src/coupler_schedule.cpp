@@ -276,7 +276,12 @@ void Coupler::step_loop(RunSummary& summary) {
   while (t_ < end * (1 - 1e-12)) {
     if (options_.stop_request && options_.stop_request->load()) {
       summary.stepping_wall_s = stepping_before_ + seconds_since(start);
-      history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+      // The row of the step it stops at, unless the last output row (a checkpoint's, or the one
+      // a restart continues after) is that step's: a row is written once per step, and a
+      // restart keeps the rows up to its checkpoint, so a second one would stay doubled.
+      if (!history.ends_at(step_)) {
+        history.write(t_, step_, dt, sides_[0].diagnostics, sides_[1].diagnostics, seconds_since(start_));
+      }
       check_stop_request();
     }
     // Steps to reach the next output time (and the end), rounded up to whole exchange windows.

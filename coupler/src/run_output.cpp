@@ -11,8 +11,8 @@
 
 namespace hfmpm::coupling {
 
-History::History(const std::string& path, bool append)
-    : out_(path, std::ios::out | (append ? std::ios::app : std::ios::trunc)) {
+History::History(const std::string& path, bool append, std::optional<std::uint64_t> last_step)
+    : out_(path, std::ios::out | (append ? std::ios::app : std::ios::trunc)), last_step_(last_step) {
   if (!out_) throw std::runtime_error("cannot write " + path);
   out_ << std::setprecision(10);
   if (append) return;
@@ -30,6 +30,7 @@ void History::write(double t, std::uint64_t step, double dt, const SideDiagnosti
        << ',' << dt << ',' << solid.crack_face_load << ',' << fluid.front_position << ',' << solid.crack_particles
        << ',' << fluid.fluid_particles << ',' << fluid.coupling_lag << '\n';
   out_.flush();
+  last_step_ = step;
 }
 
 void Manifest::set_number(const std::string& key, double value) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,13 +16,18 @@ namespace hfmpm::coupling {
 
 class History {
  public:
-  // append: continue an existing history (a restart; truncate_history first), without a new header.
-  explicit History(const std::string& path, bool append = false);
+  // append: continue an existing history (a restart; truncate_history first), without a new header;
+  // last_step: the step of its last row (what truncate_history kept).
+  explicit History(const std::string& path, bool append = false, std::optional<std::uint64_t> last_step = std::nullopt);
   void write(double t, std::uint64_t step, double dt, const SideDiagnostics& solid, const SideDiagnostics& fluid,
              double wall_s);
+  // Whether the last row is the one of `step`: a row is written once per step (a stop by a signal
+  // right after an output row writes none).
+  bool ends_at(std::uint64_t step) const { return last_step_ == step; }
 
  private:
   std::ofstream out_;
+  std::optional<std::uint64_t> last_step_;
 };
 
 // run.json: written at start, rewritten at each change of state and at the end.

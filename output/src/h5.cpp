@@ -284,10 +284,70 @@ std::string ReadFile::read_text(const std::string& object) const {
   return bytes;
 }
 
-std::string ReadFile::root_attribute(const std::string& name) const {
+std::vector<std::string> ReadFile::root_names() const {
   Quiet quiet;
-  if (H5Aexists(id_, name.c_str()) <= 0) return {};
-  Handle attribute(H5Aopen(id_, name.c_str(), default_plist()), H5Aclose);
+  std::vector<std::string> names;
+  if (H5Literate(id_, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_name, &names) < 0) fail(path_, "listing group", "/");
+  return names;
+}
+
+bool ReadFile::is_dataset(const std::string& object) const {
+  Quiet quiet;
+  Handle target(H5Oopen(id_, object.c_str(), default_plist()), H5Oclose);
+  if (!target.valid()) fail(path_, "opening object", object);
+  return H5Iget_type(target.get()) == H5I_DATASET;
+}
+
+std::string ReadFile::array_type(const std::string& object) const {
+  Quiet quiet;
+  Handle dataset(H5Dopen2(id_, object.c_str(), default_plist()), H5Dclose);
+  if (!dataset.valid()) fail(path_, "opening dataset", object);
+  Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  if (!space.valid()) fail(path_, "reading the dataspace of dataset", object);
+  if (H5Sget_simple_extent_ndims(space.get()) != 1) return {};
+  Handle type(H5Dget_type(dataset.get()), H5Tclose);
+  if (!type.valid()) fail(path_, "reading the type of dataset", object);
+  if (H5Tequal(type.get(), H5T_IEEE_F64LE) > 0) return "f64";
+  if (H5Tequal(type.get(), H5T_STD_U64LE) > 0) return "u64";
+  if (H5Tequal(type.get(), H5T_STD_U8LE) > 0) return "u8";
+  return {};
+}
+
+std::string ReadFile::raw_bytes(const std::string& object) const {
+  Quiet quiet;
+  Handle dataset(H5Dopen2(id_, object.c_str(), default_plist()), H5Dclose);
+  if (!dataset.valid()) fail(path_, "opening dataset", object);
+  Handle type(H5Dget_type(dataset.get()), H5Tclose);
+  if (!type.valid()) fail(path_, "reading the type of dataset", object);
+  Handle space(H5Dget_space(dataset.get()), H5Sclose);
+  if (!space.valid()) fail(path_, "reading the dataspace of dataset", object);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.get());
+  const std::size_t size = H5Tget_size(type.get());
+  if (n < 0 || size == 0) fail(path_, "counting the bytes of dataset", object);
+  // A damaged dataspace can claim any size: no more than the file holds is read.
+  hsize_t file_size = 0;
+  if (H5Fget_filesize(id_, &file_size) < 0) fail(path_, "reading the size of", "");
+  if (static_cast<hsize_t>(n) > file_size / size) {
+    throw std::runtime_error("HDF5 file " + path_ + ": dataset " + object + " claims " + std::to_string(n) +
+                             " elements of " + std::to_string(size) + " bytes, more than the whole file (" +
+                             std::to_string(file_size) + " bytes)");
+  }
+  // The file type as the memory type: HDF5 converts nothing.
+  std::string bytes(static_cast<std::size_t>(n) * size, '\0');
+  if (n > 0 && H5Dread(dataset.get(), type.get(), all_space(), all_space(), default_plist(), bytes.data()) < 0) {
+    fail(path_, "reading dataset", object);
+  }
+  return bytes;
+}
+
+std::string ReadFile::attribute(const std::string& object, const std::string& name) const {
+  Quiet quiet;
+  Handle target(H5Oopen(id_, object.c_str(), default_plist()), H5Oclose);
+  if (!target.valid()) fail(path_, "opening object for attribute " + name + " on", object);
+  const htri_t exists = H5Aexists(target.get(), name.c_str());
+  if (exists < 0) fail(path_, "looking up attribute " + name + " on", object);
+  if (exists == 0) return {};
+  Handle attribute(H5Aopen(target.get(), name.c_str(), default_plist()), H5Aclose);
   if (!attribute.valid()) fail(path_, "opening attribute", name);
   Handle type(H5Aget_type(attribute.get()), H5Tclose);
   if (!type.valid() || H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0) return {};

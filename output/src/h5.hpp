@@ -62,8 +62,18 @@ class ReadFile {
   std::vector<double> read_f64(const std::string& object) const;
   std::vector<std::uint64_t> read_u64(const std::string& object) const;
   std::string read_text(const std::string& object) const;  // a uint8 dataset as bytes
-  // A string attribute of the root group; empty if there is none.
-  std::string root_attribute(const std::string& name) const;
+  // The names of the root group's links, in name order.
+  std::vector<std::string> root_names() const;
+  // Whether the object is a dataset (false for a group or anything else).
+  bool is_dataset(const std::string& object) const;
+  // "f64", "u64" or "u8" for a one-dimensional dataset of the little-endian type File writes for it
+  // (IEEE float64, unsigned 64-bit or 8-bit integers); empty for any other type or shape.
+  std::string array_type(const std::string& object) const;
+  // Every element of a dataset in its file type, unconverted: the bytes the file holds for it.
+  std::string raw_bytes(const std::string& object) const;
+  // A string attribute of the root group, or of an object; empty if there is none.
+  std::string root_attribute(const std::string& name) const { return attribute("/", name); }
+  std::string attribute(const std::string& object, const std::string& name) const;
   const std::string& path() const { return path_; }
 
  private:

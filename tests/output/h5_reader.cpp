@@ -146,4 +146,46 @@ std::string H5Reader::attribute_string(const std::string& object, const std::str
   return buffer.substr(0, buffer.find('\0'));
 }
 
+std::pair<std::uint64_t, std::uint64_t> H5Reader::data_extent(const std::string& dataset) const {
+  Id d(H5Dopen2(id_, dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (d.id < 0) fail(path_, "H5Dopen2 " + dataset);
+  const hsize_t size = H5Dget_storage_size(d.id);
+  if (size == 0) return {0, 0};
+  const haddr_t offset = H5Dget_offset(d.id);
+  if (offset == HADDR_UNDEF) fail(path_, dataset + " is not contiguous (H5Dget_offset)");
+  return {offset, size};
+}
+
+namespace {
+// The file opened read-write and the object, for an attribute edit.
+struct Target {
+  Id file, object;
+  explicit Target(const std::string& path, const std::string& name)
+      : file(H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose),
+        object(file.id < 0 ? -1 : H5Oopen(file.id, name.c_str(), H5P_DEFAULT), H5Oclose) {
+    if (file.id < 0) fail(path, "H5Fopen read-write");
+    if (object.id < 0) fail(path, "H5Oopen " + name);
+  }
+};
+}  // namespace
+
+void set_string_attribute(const std::string& file, const std::string& object, const std::string& name,
+                          const std::string& value) {
+  Target target(file, object);
+  if (H5Aexists(target.object.id, name.c_str()) > 0 && H5Adelete(target.object.id, name.c_str()) < 0) {
+    fail(file, "H5Adelete " + object + " @" + name);
+  }
+  Id type(H5Tcopy(H5T_C_S1), H5Tclose);
+  H5Tset_size(type.id, value.size() + 1);
+  H5Tset_strpad(type.id, H5T_STR_NULLTERM);
+  Id space(H5Screate(H5S_SCALAR), H5Sclose);
+  Id a(H5Acreate2(target.object.id, name.c_str(), type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
+  if (a.id < 0 || H5Awrite(a.id, type.id, value.c_str()) < 0) fail(file, "writing " + object + " @" + name);
+}
+
+void delete_attribute(const std::string& file, const std::string& object, const std::string& name) {
+  Target target(file, object);
+  if (H5Adelete(target.object.id, name.c_str()) < 0) fail(file, "H5Adelete " + object + " @" + name);
+}
+
 }  // namespace hfmpm::test

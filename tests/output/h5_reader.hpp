@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hfmpm::test {
@@ -25,10 +26,18 @@ class H5Reader {
   double attribute_f64(const std::string& object, const std::string& name) const;
   std::uint64_t attribute_u64(const std::string& object, const std::string& name) const;
   std::string attribute_string(const std::string& object, const std::string& name) const;
+  // Where a contiguous dataset's elements lie in the file: byte offset and byte count ({0, 0} if it has none).
+  std::pair<std::uint64_t, std::uint64_t> data_extent(const std::string& dataset) const;
 
  private:
   std::string path_;
   std::int64_t id_ = -1;
 };
+
+// Edits of a file's attributes, for tests that make a file of an older format or a damaged one:
+// a fixed-length string attribute set (replaced if it exists), or one removed.
+void set_string_attribute(const std::string& file, const std::string& object, const std::string& name,
+                          const std::string& value);
+void delete_attribute(const std::string& file, const std::string& object, const std::string& name);
 
 }  // namespace hfmpm::test

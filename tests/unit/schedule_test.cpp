@@ -12,9 +12,11 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "fluid_scene_rules.hpp"
+#include "hfmpm/coupling/checkpoint.hpp"
 #include "hfmpm/coupling/coupler.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
 #include "prescribed_fluid_side.hpp"
@@ -129,6 +131,30 @@ TEST(Schedule, ACouplerGivenAVanishingIntervalEnds) {
     EXPECT_EQ(run.summary.steps, 200u);
     EXPECT_EQ(run.rows, 201u) << "a row at the start and after every step";
   }
+}
+
+// A restart keeps history.csv's rows up to its checkpoint, one per step: a history written before
+// the fix of issue 49 (a run stopped by a signal right after an output row wrote that step twice,
+// the second row with the next block's dt) continues with the first row only, as the uninterrupted
+// run has it. truncate_history returns the step of the last row kept.
+TEST(Schedule, ARestartKeepsOneRowPerStep) {
+  const std::string dir = hfmpm::test::scratch_dir("truncate-history");
+  const std::string path = dir + "/history.csv";
+  const std::string header = "time_s,step,crack_length_m,dt_s\n";
+  const std::string rows = "0,0,0.1,5e-05\n0.001,20,0.1,5e-05\n0.002,40,0.1,5e-05\n";
+  const std::string doubled = "0.002,40,0.1,6e-05\n";
+  const std::string after = "0.003,60,0.1,6e-05\n0.004,80,0.";  // past the checkpoint, the last cut short
+  hfmpm::test::write_file(path, header + rows + doubled + after);
+  EXPECT_EQ(hfmpm::coupling::truncate_history(path, 40), std::optional<std::uint64_t>(40));
+  EXPECT_EQ(hfmpm::test::read_file(path), header + rows);
+  hfmpm::test::write_file(path, header + rows + doubled + after);
+  EXPECT_EQ(hfmpm::coupling::truncate_history(path, 50), std::optional<std::uint64_t>(40));
+  EXPECT_EQ(hfmpm::test::read_file(path), header + rows);
+  EXPECT_EQ(hfmpm::coupling::truncate_history(path, 60), std::optional<std::uint64_t>(40));  // idempotent
+  EXPECT_EQ(hfmpm::test::read_file(path), header + rows);
+  hfmpm::test::write_file(path, header);
+  EXPECT_EQ(hfmpm::coupling::truncate_history(path, 40), std::nullopt);
+  EXPECT_EQ(hfmpm::test::read_file(path), header);
 }
 
 }  // namespace
