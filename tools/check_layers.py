@@ -3,7 +3,7 @@
 
   proto <- output, runtime, solid and fluid physics
         <- solid/side, fluid/side (physics, output, runtime), coupler (runtime)
-        <- app (coupler and both sides' adapters)
+        <- app (coupler, both sides' adapters, and output to check a restart's side files)
 
 Fails, naming the file and the include, if a folder includes a header of a
 folder it may not see. Run by ctest (unit.Layers); usage: check_layers.py [ROOT].
@@ -26,7 +26,7 @@ ALLOWED = {
     "solid/app": {"proto", "runtime", "solid", "solid/side"},
     "fluid/app": {"proto", "runtime", "fluid", "fluid/side"},
     "coupler": {"proto", "runtime", "coupler"},
-    "app": {"proto", "runtime", "coupler", "solid", "fluid", "solid/side", "fluid/side"},
+    "app": {"proto", "output", "runtime", "coupler", "solid", "fluid", "solid/side", "fluid/side"},
 }
 
 
