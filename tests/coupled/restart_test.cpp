@@ -54,6 +54,19 @@ std::vector<std::uint64_t> complete_checkpoints(const std::string& out) {
   return steps;
 }
 
+// The uninterrupted run of the tests that restart from a chosen checkpoint:
+// 0.2 s with a checkpoint every 0.06 s; the steps of its complete checkpoints
+// (none if the run failed).
+std::vector<std::uint64_t> run_with_two_checkpoints(const std::string& out) {
+  auto argv = run_args(out);
+  argv[std::find(argv.begin(), argv.end(), "time.end_s=0.4") - argv.begin()] = "time.end_s=0.2";
+  argv[std::find(argv.begin(), argv.end(), "output.checkpoint_interval_s=0.15") - argv.begin()] =
+      "output.checkpoint_interval_s=0.06";
+  const auto whole = run(argv, 120);
+  EXPECT_EQ(whole.exit_code, 0) << whole.err;
+  return whole.exit_code == 0 ? complete_checkpoints(out) : std::vector<std::uint64_t>{};
+}
+
 std::uint64_t last_history_step(const std::string& out) {
   std::ifstream in(out + "/history.csv");
   std::string line, last;
@@ -245,13 +258,7 @@ TEST(Restart, ReleasedGrowthStepContinuesBitForBit) {
 TEST(Restart, CouplerWithSidesStartedByHandContinues) {
   const auto dir = scratch_dir("restart-join");
   const std::string a = dir + "/a", b = dir + "/b";
-  auto argv = run_args(a);
-  argv[std::find(argv.begin(), argv.end(), "time.end_s=0.4") - argv.begin()] = "time.end_s=0.2";
-  argv[std::find(argv.begin(), argv.end(), "output.checkpoint_interval_s=0.15") - argv.begin()] =
-      "output.checkpoint_interval_s=0.06";
-  const auto whole = run(argv, 120);
-  ASSERT_EQ(whole.exit_code, 0) << whole.err;
-  const auto steps = complete_checkpoints(a);
+  const auto steps = run_with_two_checkpoints(a);
   ASSERT_EQ(steps.size(), 2u);
   fs::copy(a, b, fs::copy_options::recursive);
   std::ostringstream last;
@@ -313,13 +320,7 @@ void move_a_particle(const std::string& solid_file) {
 TEST(Restart, DamagedCheckpointFallsBackToTheOneBeforeOrIsRefused) {
   const auto dir = scratch_dir("restart-damaged");
   const std::string a = dir + "/a", b = dir + "/b", c = dir + "/c";
-  auto argv = run_args(a);
-  argv[std::find(argv.begin(), argv.end(), "time.end_s=0.4") - argv.begin()] = "time.end_s=0.2";
-  argv[std::find(argv.begin(), argv.end(), "output.checkpoint_interval_s=0.15") - argv.begin()] =
-      "output.checkpoint_interval_s=0.06";
-  const auto whole = run(argv, 120);
-  ASSERT_EQ(whole.exit_code, 0) << whole.err;
-  const auto steps = complete_checkpoints(a);
+  const auto steps = run_with_two_checkpoints(a);
   ASSERT_EQ(steps.size(), 2u);
   fs::copy(a, b, fs::copy_options::recursive);
   fs::copy(a, c, fs::copy_options::recursive);
