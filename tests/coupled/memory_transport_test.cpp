@@ -5,6 +5,7 @@
 // (inproc: the same threads, over sockets).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,15 +51,27 @@ const coupling::SceneRules& rules() {
 }
 
 // scenarios/kgd-viscosity-ci.scene cut to its first 0.8 s (a history row
-// every 0.16 s), as threads. (Cut at 0.5 s it grew only because its first
-// implicit step was committed 2e-7 under-filled, a kick that grew the notch
-// by a quarter cell before 0.25 s; since such a step is retried in
-// substeps, the crack first grows between 0.5 and 0.75 s, and from 0.75 s
-// to 1.25 s its length is the old run's to 2e-6 m.)
+// every 0.16 s) at the 5-s run's step (kKgdViscosityCiMethod), as threads:
+// long enough for the crack to grow (the 5-s run's is 0.1544 m at 0.25 and
+// 0.5 s, one growth step past the notch, and 0.1718 m at 0.75 s).
 scene::Scene small_kgd() {
-  return coupling::load_scene(
-      source("scenarios/kgd-viscosity-ci.scene"), rules(),
-      {"time.end_s=0.8", "output.interval_s=0.16", "output.hdf5=false", "coupling.transport=INPROC"});
+  std::vector<std::string> overrides{"time.end_s=0.8", "output.interval_s=0.16", "output.hdf5=false",
+                                     "coupling.transport=INPROC"};
+  overrides.insert(overrides.end(), kKgdViscosityCiMethod.begin(), kKgdViscosityCiMethod.end());
+  return coupling::load_scene(source("scenarios/kgd-viscosity-ci.scene"), rules(), overrides);
+}
+
+// The keys the tests that cut kgd-viscosity-ci short set
+// (kKgdViscosityCiMethod) are those its 5-s run derives, with their values.
+TEST(MemoryTransport, ShortKgdRunsSetThe5sRunsDerivedMethod) {
+  std::vector<method::Setting> derived;
+  coupling::load_scene(source("scenarios/kgd-viscosity-ci.scene"), rules(), {}, &derived);
+  for (const auto& assignment : kKgdViscosityCiMethod) {
+    const auto key = assignment.substr(0, assignment.find('='));
+    const auto found = std::find_if(derived.begin(), derived.end(), [&](const auto& s) { return s.key == key; });
+    ASSERT_NE(found, derived.end()) << key << " is not derived";
+    EXPECT_EQ(found->key + "=" + found->value, assignment);
+  }
 }
 
 TEST(MemoryTransport, KgdOfTheMpmSolidAndFluidRunsInOneProcessAsOverZeroMq) {

@@ -26,9 +26,9 @@ scene::Scene parsed(const std::string& text) {
 }
 
 // The lab viscosity-dominated KGD written with its physics only
-// (scenarios/kgd-physics-only-ci.scene).
+// (scenarios/kgd-viscosity-ci.scene).
 scene::Scene physics_only() {
-  return parsed(hfmpm::test::read_file(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene")));
+  return parsed(hfmpm::test::read_file(hfmpm::test::source("scenarios/kgd-viscosity-ci.scene")));
 }
 
 const Setting* find(const std::vector<Setting>& settings, const std::string& key) {
@@ -259,14 +259,14 @@ TEST(Method, EffectiveTimeOfTheInjection) {
 // sides' rules; a scene's own key set against a derived one is named.
 TEST(Method, TheLoaderDerivesAndReportsTheMethod) {
   std::vector<Setting> derived;
-  const auto s = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"),
+  const auto s = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity-ci.scene"),
                                              hfmpm::test::side_rules(), {}, &derived);
   EXPECT_EQ(s.coupling().scheme(), scene::Coupling::IMPLICIT);
   EXPECT_GE(derived.size(), 19u);
   const std::string text = describe(derived, "#   ");
   EXPECT_THAT(text, HasSubstr("#   solid.mpm.density_scaling: 8.3   # quasi-static"));
   // A lag pressure the scene sets, beside the derived matched closure, is kept.
-  const auto kept = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"),
+  const auto kept = hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity-ci.scene"),
                                                 hfmpm::test::side_rules(), {"fluid.mpm.lag_pressure_pa=2e5"});
   EXPECT_DOUBLE_EQ(kept.fluid().mpm().lag_pressure_pa(), 2e5);
 }
@@ -311,7 +311,7 @@ TEST(Method, HostilePhysicsGetsNoDerivedNumbersAndTheRulesNameIt) {
       EXPECT_EQ(setting.value.find("inf"), std::string::npos) << setting.key;
     }
     try {
-      hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-physics-only-ci.scene"), hfmpm::test::side_rules(),
+      hfmpm::coupling::load_scene(hfmpm::test::source("scenarios/kgd-viscosity-ci.scene"), hfmpm::test::side_rules(),
                                   {assignment});
       ADD_FAILURE() << "accepted";
     } catch (const hfmpm::coupling::SceneError& e) {
