@@ -136,12 +136,13 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
   const int n = crack->x_m_size();
   const int inlet = crack->has_inlet_vertex() ? static_cast<int>(crack->inlet_vertex()) : 0;
   if (inlet < 0 || inlet >= n) return refuse("no inlet vertex");
-  double length = 0;
+  double length = 0, before = 0;  // m, the whole crack and its part up to the inlet vertex
   bool straight = true;
   const double dx0 = crack->x_m(n - 1) - crack->x_m(0), dy0 = crack->y_m(n - 1) - crack->y_m(0);
   for (int i = 1; i < n; ++i) {
     const double dx = crack->x_m(i) - crack->x_m(i - 1), dy = crack->y_m(i) - crack->y_m(i - 1);
     length += std::hypot(dx, dy);
+    if (i == inlet) before = length;
     if (std::abs(dx * dy0 - dy * dx0) > 1e-9 * std::hypot(dx, dy) * std::hypot(dx0, dy0)) straight = false;
   }
   const bool both = crack->has_inlet_vertex() && inlet > 0 && inlet < n - 1;
@@ -181,7 +182,8 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
   if (!(p.total_rate > 0) || !(p.effective_s > 0) || !(p.viscosity > 0)) {
     return refuse("no injection at the end, or an inviscid fluid: no vertex to size the run by");
   }
-  p.notch = both ? 0.5 * length : length;
+  // A well inside the body: the shorter wing, which the fluid's fill may not pass.
+  p.notch = both ? std::min(before, length - before) : length;
   // The in-situ stress at the well, compressive, on the crack's plane.
   const auto& st = region->initial_stress();
   const double sxx = -st.xx_pa(), syy = -st.yy_pa(), sxy = -st.xy_pa();

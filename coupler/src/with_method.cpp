@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "hfmpm/coupling/method.hpp"
 #include "hfmpm/coupling/number_text.hpp"
@@ -75,6 +76,14 @@ bool in_situ_in_equilibrium(const scene::MpmSolid& m) {
     }
   }
   return stressed;
+}
+
+// v written so that it reads back no larger: the fill's front may not pass
+// the wing it fills (to six digits a 45-degree notch's wing, 0.1499999 m,
+// reads 0.15).
+std::string num_at_most(double v) {
+  const std::string nearest = num(v);
+  return std::stod(nearest) > v ? num(text::significant(v, 6, true)) : nearest;
 }
 
 }  // namespace
@@ -175,7 +184,7 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
                              : "the dry tip zone carries the minimum in-situ stress the crack turns to");
     }
     derive_key(s, applied, "fluid.mpm.initial_fill",
-               "{ front_m: " + num(p.notch) + " pressure_pa: " + num(std::max(0.0, p.normal_stress)) + " }",
+               "{ front_m: " + num_at_most(p.notch) + " pressure_pa: " + num(std::max(0.0, p.normal_stress)) + " }",
                "the notch filled to its tip at the in-situ stress normal to it");
   } else if (mpm_fluid && cracks && applied_out) {
     applied.push_back({"(fluid-driven crack)", "not derived", why_not});

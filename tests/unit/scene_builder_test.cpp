@@ -8,8 +8,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "fluid_scene_rules.hpp"
 #include "hfmpm/coupling/scene_loader.hpp"
@@ -330,6 +332,39 @@ TEST(SceneBuilder, InclinedNotchUnderAnisotropicStress) {
   aligned_form.mutable_injection()->set_both_wings(true);
   aligned_form.set_notch_azimuth_deg(30);
   EXPECT_THAT(refusal(aligned_form), HasSubstr("needs the in-situ stress as in_situ { sigma_hmin_pa"));
+}
+
+// Every notch azimuth builds a scene its sides accept. The derived fill runs
+// to the tip of the shorter wing as the scene's coordinates give it: written
+// to six digits, a 45-degree wing of 0.15 m (0.106066 m along x and y) reads
+// 0.1499999 m, and a fill front written 0.15 was refused by the fluid's rule
+// (at most the shorter wing). Each whole degree from -89 to 90, three notch
+// lengths, the two wells of the in-situ tensor (SHmax along x and at 20 deg).
+TEST(SceneBuilder, EveryNotchAzimuthGivesAValidScene) {
+  int built = 0;
+  for (const double notch : {0.15, 0.1, 0.37}) {
+    for (const double shmax_azimuth : {0.0, 20.0}) {
+      for (int azimuth = -89; azimuth <= 90; ++azimuth) {
+        problem::Problem p = toughness_problem();
+        p.mutable_injection()->set_both_wings(true);
+        p.mutable_in_situ()->Clear();
+        p.mutable_in_situ()->set_sigma_hmin_pa(1e5);
+        p.mutable_in_situ()->set_sigma_hmax_pa(1.2e5);
+        p.mutable_in_situ()->set_sigma_hmax_azimuth_deg(shmax_azimuth);
+        p.set_notch_m(notch);
+        p.set_notch_azimuth_deg(azimuth);
+        SCOPED_TRACE(std::to_string(notch) + " m at " + std::to_string(azimuth) + " deg");
+        const scene::Scene s = checked(build_scene(p));
+        const auto& crack = s.solid().mpm().cracks(0);
+        const double wing = std::min(std::hypot(crack.x_m(1) - crack.x_m(0), crack.y_m(1) - crack.y_m(0)),
+                                     std::hypot(crack.x_m(2) - crack.x_m(1), crack.y_m(2) - crack.y_m(1)));
+        EXPECT_LE(s.fluid().mpm().initial_fill().front_m(), wing);
+        EXPECT_NEAR(s.fluid().mpm().initial_fill().front_m(), notch, 1e-5 * notch);
+        ++built;
+      }
+    }
+  }
+  EXPECT_EQ(built, 3 * 2 * 180);
 }
 
 TEST(SceneBuilder, CautionsWhereTheMatrixFailed) {
