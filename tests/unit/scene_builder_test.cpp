@@ -20,7 +20,9 @@
 namespace hfmpm::app {
 namespace {
 
+using ::testing::Contains;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 // The method paper's field set-up (scenarios/problems/kgd-paper-field.problem).
 problem::Problem field_problem() {
@@ -323,6 +325,19 @@ TEST(SceneBuilder, InclinedNotchUnderAnisotropicStress) {
   const scene::Scene with = checked(sheared_well);
   ASSERT_GE(with.cautions_size(), 1);
   EXPECT_THAT(with.cautions(with.cautions_size() - 1), HasSubstr("grows in shear"));
+  // The caution fires above 1.5 K_Ic: 45 degrees under 200 / 100 kPa puts
+  // 50 kPa of shear on the notch, 1.49 K_Ic at K_Ic = 23 kPa m^0.5 (measured:
+  // ran with symmetric wings) and 2.02 at 17 kPa m^0.5 (one wing ran ahead).
+  problem::Problem at_45 = p;
+  at_45.set_notch_azimuth_deg(45);
+  at_45.mutable_in_situ()->set_sigma_hmax_pa(2e5);
+  at_45.mutable_in_situ()->set_sigma_hmax_azimuth_deg(0);
+  at_45.set_notch_friction_coefficient(0);
+  at_45.mutable_fluid()->set_viscosity_pa_s(1e-3);
+  at_45.mutable_rock()->set_toughness_pa_sqrt_m(23e3);
+  for (const auto& caution : build_scene(at_45).derived.cautions) EXPECT_THAT(caution, Not(HasSubstr("in shear")));
+  at_45.mutable_rock()->set_toughness_pa_sqrt_m(17e3);
+  EXPECT_THAT(build_scene(at_45).derived.cautions, Contains(HasSubstr("2.02 times K_Ic")));
   // Refused: an angle without both wings, or with the aligned form of the stress.
   problem::Problem one_wing = p;
   one_wing.set_notch_azimuth_deg(30);
