@@ -2,7 +2,9 @@
 // run as a whole, and shutdown. See coupler_session.hpp for the parts.
 #include <google/protobuf/util/json_util.h>
 
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 
 #include "coupler_session.hpp"
 #include "hfmpm/coupling/run_state.hpp"
@@ -133,7 +135,10 @@ RunSummary Coupler::run() {
     manifest_.set_number("max_coupling_lag_pa", max_coupling_lag_);
     manifest_.set_number("max_coupling_lag_t_s", max_coupling_lag_t_);
   }
-  if (prepared_) manifest_.save();
+  if (prepared_) {
+    manifest_.save();
+    manifest_.release_reserve();
+  }
   return summary;
 }
 
@@ -165,6 +170,8 @@ void Coupler::prepare() {
   output_dir_ = fs::absolute(options_.output_dir).string();
   log_.open(output_dir_ + "/coupler.log", options_.progress, options_.restart != nullptr);
   manifest_ = Manifest(output_dir_ + "/run.json");
+  // Disk kept for run.json's last saves: on a full disk they still name the failure.
+  manifest_.keep_reserve(kManifestReserveBytes);
   run_id_ = random_id();
   manifest_.set("run_id", run_id_);
   manifest_.set("scene", options_.scene_path);
@@ -318,8 +325,15 @@ void Coupler::prepare() {
       const auto end = text.find('"', at + 11);
       text.replace(at, end + 1 - at, "\"status\": \"aborted by " + signal_name(signal) + "\"");
       const std::string tmp = manifest + ".abort";
-      std::ofstream(tmp) << text;
-      std::rename(tmp.c_str(), manifest.c_str());
+      std::remove((manifest + ".reserve").c_str());  // the space kept for this (Manifest::keep_reserve)
+      std::ofstream out(tmp);
+      out << text;
+      // Only a whole file replaces the last good one.
+      if (out.flush()) {
+        std::rename(tmp.c_str(), manifest.c_str());
+      } else {
+        std::remove(tmp.c_str());
+      }
     });
   }
   if (options_.on_bound) options_.on_bound(control_endpoint_);

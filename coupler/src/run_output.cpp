@@ -1,9 +1,12 @@
 #include "run_output.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -64,19 +67,64 @@ void Manifest::append(const std::string& key, const std::string& value) {
   fields_[key] = json + "\n  ]";
 }
 
-void Manifest::save() const {
-  // Write then rename, so a reader never sees half a file.
+int Manifest::write() const {
+  // Write then rename, so a reader never sees half a file; every byte checked
+  // before the rename, so a full disk never replaces the last good file.
   const std::string tmp = path_ + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << "{\n";
-    std::size_t i = 0;
-    for (const auto& [key, value] : fields_) {
-      out << "  \"" << key << "\": " << value << (++i < fields_.size() ? ",\n" : "\n");
-    }
-    out << "}\n";
+  std::string text = "{\n";
+  std::size_t i = 0;
+  for (const auto& [key, value] : fields_) {
+    text += "  \"" + key + "\": " + value + (++i < fields_.size() ? ",\n" : "\n");
   }
-  std::rename(tmp.c_str(), path_.c_str());
+  text += "}\n";
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) return errno;
+  int error = 0;
+  std::size_t done = 0;
+  while (done < text.size() && error == 0) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n > 0) {
+      done += static_cast<std::size_t>(n);
+    } else {
+      error = n < 0 ? errno : ENOSPC;
+    }
+  }
+  if (error == 0 && ::fsync(fd) != 0) error = errno;
+  if (::close(fd) != 0 && error == 0) error = errno;
+  if (error == 0 && std::rename(tmp.c_str(), path_.c_str()) != 0) error = errno;
+  if (error != 0) std::remove(tmp.c_str());
+  return error;
+}
+
+void Manifest::save() {
+  int error = write();
+  if (error == 0) return;
+  if (!reserve_.empty()) {
+    release_reserve();
+    error = write();
+    if (error == 0) return;
+  }
+  // The last good run.json stays; say why it is not newer.
+  std::cerr << "hfmpm: cannot write " << path_ << ": " << std::strerror(error) << " (the last complete one is kept)\n";
+}
+
+void Manifest::keep_reserve(std::size_t bytes) {
+  const std::string path = path_ + ".reserve";
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) return;
+  const std::string zeros(bytes, '\0');
+  const bool kept = ::write(fd, zeros.data(), zeros.size()) == static_cast<ssize_t>(zeros.size());
+  ::close(fd);
+  if (kept) {
+    reserve_ = path;
+  } else {
+    std::remove(path.c_str());
+  }
+}
+
+void Manifest::release_reserve() {
+  if (!reserve_.empty()) std::remove(reserve_.c_str());
+  reserve_.clear();
 }
 
 void Log::open_file(const std::string& path, bool append) {

@@ -3,6 +3,7 @@
 // and the progress line.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <fstream>
 #include <map>
@@ -31,6 +32,10 @@ class History {
 };
 
 // run.json: written at start, rewritten at each change of state and at the end.
+// The disk a run keeps for its last run.json saves (Manifest::keep_reserve):
+// run.json with every list is a few kB; its warnings are cut at 4 kB each.
+inline constexpr std::size_t kManifestReserveBytes = std::size_t{256} * 1024;
+
 class Manifest {
  public:
   explicit Manifest(std::string path) : path_(std::move(path)) {}
@@ -38,11 +43,21 @@ class Manifest {
   void set_number(const std::string& key, double value);
   // Appends a string to the list `key` (a JSON array).
   void append(const std::string& key, const std::string& value);
-  void save() const;
+  // Writes run.json whole or not at all: a write that fails (a full disk)
+  // leaves the last good file. On a failure it frees the reserve (below) and
+  // tries once more, so that the run's last state, which names the failure,
+  // still reaches a full disk.
+  void save();
+  // Keeps `bytes` of the disk for the last saves: a file beside run.json,
+  // written now, removed by save() on a failed write or by release_reserve().
+  void keep_reserve(std::size_t bytes);
+  void release_reserve();
 
  private:
   static std::string quoted(const std::string& value);
+  int write() const;  // 0, or the errno that stopped it
   std::string path_;
+  std::string reserve_;  // the reserve file, empty when none is held
   std::map<std::string, std::string> fields_;
   std::map<std::string, std::vector<std::string>> lists_;
 };
