@@ -52,7 +52,7 @@ points lie from the reference path of the same tip, in growth steps.
       HFMPM_OBLIQUE_CELLS=n) against the reference for its load history: where the end tip's
       path crosses y = 1.5 m, the headings at the end, the largest distance between the paths;
       the reference's own convergence in its step; a PNG of all the paths; with
-      --max-distance s, exits 1 if hfmpm's new crack particles lie farther than s growth steps
+      --max-distance s, exits 1 if a tip cut by hfmpm's growth lies farther than s growth steps
       from the reference path (ctest: verification.CurvedPath.*).
   /usr/bin/python3 tools/curved_path.py --fluid --E 2e10 --nu 0.25 --KIc 1e6 --sigma-H 20.5e6
           --sigma-h 20e6 --azimuth 0 --theta 30 --a0 5 --Q 1e-3 --ds 0.5 --steps 30
@@ -1097,8 +1097,8 @@ def reference_for(growth, h, fraction, plate):
 
 def compare(paths, png, fractions, plate, max_distance=None):
     """Each MPM path file against the reference for its load history. With max_distance,
-    returns False if any run's new crack particles lie farther than that many growth steps
-    from the reference path."""
+    returns False if any run's growth steps (the tip each cut) lie farther than that many
+    growth steps from the reference path."""
     rows, curves = [], []
     for path in paths:
         growth, plane, h = read_run(path)
@@ -1117,19 +1117,22 @@ def compare(paths, png, fractions, plate, max_distance=None):
         def worst(points):
             return max((distance_to(ref, q) for q in points), default=float("nan"))
 
+        def grown(tip):  # the tip as each of its growth steps cut it, from the crack's centre
+            return [np.array([g["x"] - h / 2, g["y"]]) for g in growth if g["tip"] == tip]
+
         rows.append({"cells": round(1 / h), "h": h, "steps": (n_start, n_end),
                      "p": (min(g["p"] for g in growth), max(g["p"] for g in growth)),
                      "mpm": (crossing(mpm, 1.5), -crossing(mpm, -1.5, from_end=False)),
                      "ref": [(crossing(refs[f], 1.5), -crossing(refs[f], -1.5, from_end=False)) for f in fractions],
                      "inf": crossing(infinite, 1.5),
-                     "dist": (worst(mpm[len(mpm) - n_end:]) / step, worst(mpm[:n_start]) / step),
+                     "dist": (worst(grown("end")) / step, worst(grown("start")) / step),
                      "heading": (heading(mpm, 2 * h), heading(ref, 2 * h))})
         curves.append((round(1 / h), mpm, ref))
     fr_txt = " / ".join(f"{f:g}" for f in fractions)
     print(f"Where the end tip's path crosses y = +1.5 m (x from the crack's centre, m; the start tip's crossing of "
           f"y = -1.5 m, mirrored, after the slash); the reference in the MPM's plate (+-{plate:g} m, traction "
           f"edges) at growth steps of {fr_txt} times the MPM's, and in an infinite body; the largest distance of "
-          "hfmpm's new crack particles from the reference path in units of the MPM's growth step:")
+          "the tips hfmpm's growth steps cut from the reference path in units of the MPM's growth step:")
     print(f"| h | steps per tip | pressure at growth (MPa) | hfmpm | reference, steps {fr_txt} | infinite body | "
           "hfmpm - reference (end) | largest distance, end / start tip (growth steps) | heading at the end, hfmpm / "
           "reference (deg) |")
@@ -1260,7 +1263,7 @@ def main():
                     help="the solver against closed forms (all: both parts)")
     ap.add_argument("--png", help="draw the paths")
     ap.add_argument("--max-distance", type=float,
-                    help="fail (exit 1) if a run's new crack particles (with --fluid: hfmpm's tips, --tips) lie "
+                    help="fail (exit 1) if a tip a run's growth cut (with --fluid: hfmpm's crack particles, --tips) lies "
                          "farther than this many of its growth steps from the reference path")
     ap.add_argument("--plate", type=float, default=None,
                     help="the body's half-width in m, 0 for an infinite body (default: the MPM test's plate, 5; "

@@ -58,7 +58,7 @@ Expected expect(const Physics& p) {
   return x;
 }
 
-Method derive(const Physics& p, double h, double reach, double chosen_scaling, double chosen_growth) {
+Method derive(const Physics& p, double h, double reach, const Chosen& chosen) {
   Method d;
   d.expected = expect(p);
   const double l_end = d.expected.end.half_length, t_end = p.end_s, nu = p.poisson_ratio, e = p.youngs_modulus;
@@ -88,12 +88,32 @@ Method derive(const Physics& p, double h, double reach, double chosen_scaling, d
   if (!d.settle) {
     while (growth > 1.0 / 16 && 2 * growth * h > 0.025 * 3 * p.notch) growth /= 2;
   }
-  d.growth_cells = chosen_growth > 0 ? chosen_growth : growth;
+  d.growth_cells = chosen.growth_cells > 0 ? chosen.growth_cells : growth;
   if (d.settle) {
     const double c_s_needed = 2 * l_end * d.tip_speed / (d.growth_cells * h);
     scaling = std::min(scaling, std::pow(c_s / c_s_needed, 2));
   }
-  d.density_scaling = chosen_scaling > 0 ? chosen_scaling : significant(std::max(1.0, scaling), 2, true);
+  // Tips that turn wait, after each growth step, front_settle_transits
+  // shear transits of their J domain once the fluid front is within reach:
+  // that caps them at g c_s / (front_settle_transits j_outer_cells), whatever
+  // the crack's length. Both vertices grow as t^(2/3), so the tip slows
+  // down: keep the cap above its speed when the crack reaches three notch
+  // lengths, 2/3 l_3 / t_3 (the fluid-driven field well at 30 degrees, held
+  // by the cap to 0.29 m/s against this speed of 0.54 m/s, reached 30.9 m of
+  // the aligned well's 45.2 m at 100 s; docs/scenes.md, "The derived method").
+  const double l_3 = std::min(3 * p.notch, l_end);
+  d.t_3 = p.effective_s * std::pow(std::min(1.0, 3 * p.notch / l_end), 1.5);
+  d.early_tip_speed = 2.0 / 3.0 * l_3 / d.t_3;
+  if (chosen.turning_waits && chosen.front_settle_transits > 0) {
+    const double c_s_needed = chosen.front_settle_transits * chosen.j_outer_cells * d.early_tip_speed / d.growth_cells;
+    const double capped = std::pow(c_s / c_s_needed, 2);
+    if (capped < scaling) {
+      scaling = capped;
+      d.front_settle_capped = true;
+    }
+  }
+  d.density_scaling =
+      chosen.density_scaling > 0 ? chosen.density_scaling : significant(std::max(1.0, scaling), 2, true);
   d.virtual_opening = significant(0.01 * d.expected.end.opening, 2, false);
   // Damping (mass-proportional, alpha): critical for the body's lowest mode,
   // omega_1 = pi c / (2 B) (a quarter wave across the body's reach B), but no
@@ -103,7 +123,6 @@ Method derive(const Physics& p, double h, double reach, double chosen_scaling, d
   // scale), the body lagged the load and the net pressure ran 8% above the vertex.
   d.scaled_c = c_p / std::sqrt(d.density_scaling);
   d.body_omega = std::numbers::pi * d.scaled_c / (2 * reach);
-  d.t_3 = p.effective_s * std::pow(std::min(1.0, 3 * p.notch / l_end), 1.5);
   double damping = std::min(2 * d.body_omega, 0.02 * d.body_omega * d.body_omega * d.t_3);
   if (d.settle) {
     // With toughness each growth step rings the crack: the release of the
@@ -111,7 +130,6 @@ Method derive(const Physics& p, double h, double reach, double chosen_scaling, d
     // a shear transit later. Damp the crack's quarter-wave mode along its
     // length at three notch lengths, omega_c = pi c_s / (2 L_3), critically,
     // within the same 2% lag (docs/verification.md, "A growth step without a jolt").
-    const double l_3 = std::min(3 * p.notch, l_end);
     const double omega_c = std::numbers::pi * c_s / std::sqrt(d.density_scaling) / (2 * l_3);
     damping = std::max(damping, std::min(2 * omega_c, 0.02 * omega_c * omega_c * d.t_3));
   }

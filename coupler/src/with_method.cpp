@@ -121,9 +121,20 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
     // The damping and the zero-lag wait follow the scene's own density
     // scaling and growth step where it sets them.
     const auto& fracture = s.solid().mpm().fracture();
-    const Method d = derive(p, physics->cell, physics->reach,
-                            s.solid().mpm().has_density_scaling() ? s.solid().mpm().density_scaling() : 0,
-                            fracture.has_growth_cells() ? fracture.growth_cells() : 0);
+    Chosen chosen;
+    chosen.density_scaling = s.solid().mpm().has_density_scaling() ? s.solid().mpm().density_scaling() : 0;
+    chosen.growth_cells = fracture.has_growth_cells() ? fracture.growth_cells() : 0;
+    // The turning tips' settling wait, as the scene sets it or as it will be
+    // derived below.
+    const bool turning =
+        fracture.has_direction() ? fracture.direction() == scene::FractureSpec::MAX_HOOP_STRESS : !p.symmetric;
+    const bool zero_lag = fracture.has_max_lag_cells()
+                              ? fracture.max_lag_cells() >= 0
+                              : s.fluid().mpm().lag() != scene::MpmFluid::ZERO_PRESSURE || !is_set(s, "fluid.mpm.lag");
+    chosen.turning_waits = turning && zero_lag;
+    chosen.front_settle_transits = fracture.front_settle_transits();
+    if (fracture.has_j_outer_cells()) chosen.j_outer_cells = fracture.j_outer_cells();
+    const Method d = derive(p, physics->cell, physics->reach, chosen);
     const Expected& x = d.expected;
     const double l_end = x.end.half_length;
     const std::string vertex = x.viscosity_dominated ? "M" : "K";
@@ -131,13 +142,17 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
       derive_key(s, applied, "solid.mpm.fracture.propagate", "true",
                  "the rock at the well has a toughness: its crack grows where J reaches it");
     }
-    derive_key(
-        s, applied, "solid.mpm.density_scaling", num(d.density_scaling),
-        "quasi-static: the scaled P-wave (" + approx(d.scaled_c) +
-            " m/s) crosses the expected final "
-            "half-length " +
-            approx(l_end) + " m in " + approx(100 * l_end / d.scaled_c / p.end_s) + "% of the injection (target 0.5%" +
-            (d.settle ? "; with toughness, the settling wait may not cap the tip below its final speed" : "") + ")");
+    derive_key(s, applied, "solid.mpm.density_scaling", num(d.density_scaling),
+               "quasi-static: the scaled P-wave (" + approx(d.scaled_c) +
+                   " m/s) crosses the expected final "
+                   "half-length " +
+                   approx(l_end) + " m in " + approx(100 * l_end / d.scaled_c / p.end_s) +
+                   "% of the injection (target 0.5%" +
+                   (d.settle ? "; with toughness, the settling wait may not cap the tip below its final speed" : "") +
+                   (d.front_settle_capped ? "; the turning tips' wait after each step may not cap them below " +
+                                                approx(d.early_tip_speed) + " m/s, their speed at three notch lengths"
+                                          : "") +
+                   ")");
     derive_key(s, applied, "solid.mpm.damping.grid_alpha_per_s", num(d.damping),
                "critical for the body's lowest mode (" + approx(d.body_omega) + " rad/s over its reach " +
                    approx(physics->reach) + " m)" +

@@ -32,29 +32,25 @@ TEST(ObliqueGrowth, InclinedCrackUnderTensionGrowsPastTheKink) {
   EXPECT_GE(log.back().start_grown, kSteps);
   EXPECT_GE(log.back().end_grown, kSteps);
   const auto& plane = solid.cracks()[0].plane();
-  const std::size_t initial = static_cast<std::size_t>(std::lround(4 * kA / h)) + 1;
-  const std::size_t start_new = static_cast<std::size_t>(log.back().start_grown);
-  // Headings of the grown segments, from each initial tip outwards (the
-  // start tip's mapped by 180 deg onto the end tip's by symmetry).
-  auto segment_heading = [&](std::size_t from, std::size_t to, bool flip) {
-    const Vec2 d = plane[to] - plane[from];
+  // Headings of the growth steps, from each initial tip outwards (the start
+  // tip's mapped by 180 deg onto the end tip's by symmetry): the old tip to
+  // the new one, each as it was cut (a step may lengthen the tip segment
+  // rather than add a particle).
+  auto step_heading = [](const Growth& g) {
+    const bool end = g.tip.at_end;
+    const Vec2 d = (end ? g.plane.back() : g.plane.front()) - (end ? g.before.back() : g.before.front());
     double a = std::atan2(d.y(), d.x()) * 180 / kPi;
-    if (flip) a = a > 0 ? a - 180 : a + 180;
+    if (!end) a = a > 0 ? a - 180 : a + 180;
     return a;
   };
   const double first_exact = 45 - 53.13;
   for (const bool at_end : {false, true}) {
     std::vector<double> headings, kinks, k2;
-    if (at_end) {
-      for (std::size_t k = start_new + initial - 1; k + 1 < plane.size(); ++k)
-        headings.push_back(segment_heading(k, k + 1, false));
-    } else {
-      for (std::size_t k = start_new; k > 0; --k) headings.push_back(segment_heading(k, k - 1, true));
-    }
     // The kink (deg, counter-clockwise from the crack's direction at the tip,
     // the same mapped by 180 deg) and K_II/K_I measured at each growth step.
     for (const auto& g : log) {
       if (g.tip.at_end != at_end) continue;
+      headings.push_back(step_heading(g));
       kinks.push_back(g.tip.kink * 180 / kPi);
       k2.push_back(g.tip.k2 / g.tip.k1);
     }

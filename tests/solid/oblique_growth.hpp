@@ -70,15 +70,15 @@ std::vector<Growth> grow(Solver& solid, Pressure pressure, Done done, double end
   while (solid.time() < end && !done(grown[0], grown[1])) {
     auto& crack = solid.cracks()[0];
     crack.pressure().assign(crack.size(), pressure(solid.time()));
-    const std::size_t before = crack.size();
     const Vec2 first = crack.plane().front(), last = crack.plane().back();
     const std::vector<Vec2> shape = crack.plane();
     solid.step(dt);
-    if (solid.cracks()[0].size() == before) continue;
-    // Which tips grew: the one whose end particle is new.
+    // Which tips grew: the one whose end particle is new, or moved a growth
+    // step (a short tip segment lengthened; docs/solid.md, "Crack particles
+    // at least half a cell apart").
     for (const auto& tip : solid.last_tips()) {
       const Vec2& now = tip.at_end ? solid.cracks()[0].plane().back() : solid.cracks()[0].plane().front();
-      if ((now - (tip.at_end ? last : first)).norm() < 1e-3 * solid.grid().h) continue;
+      if ((now - (tip.at_end ? last : first)).norm() < 0.02 * solid.grid().h) continue;  // steps are >= h / 16
       ++grown[tip.at_end ? 1 : 0];
       log.push_back({tip, grown[0], grown[1], solid.cracks()[0].plane(), shape, solid.time()});
       print(log.back());

@@ -83,14 +83,15 @@ TEST(ObliqueGrowth, IsotropicStressGrowsStraightAndSymmetric) {
   ASSERT_NE(tenth, log.end());
   const auto& plane = tenth->plane;
   const Vec2 dir(std::cos(angle), std::sin(angle));
-  const std::size_t initial = static_cast<std::size_t>(std::lround(4 * kA / h)) + 1;
-  const std::size_t start_new = kSteps;
-  const std::vector<Vec2> start_part(plane.begin(), plane.begin() + static_cast<std::ptrdiff_t>(start_new));
-  const std::vector<Vec2> end_part(plane.begin() + static_cast<std::ptrdiff_t>(start_new + initial), plane.end());
+  // Each tip as each of its growth steps cut it (a step may lengthen the tip
+  // segment rather than add a particle).
+  std::vector<Vec2> start_part, end_part;
+  for (auto g = log.begin(); g != std::next(tenth); ++g)
+    (g->tip.at_end ? end_part : start_part).push_back(g->tip.at_end ? g->plane.back() : g->plane.front());
   const double grown = kSteps * c.fracture.growth_cells * h;
   const double start_off = off_line(start_part, centre, dir), end_off = off_line(end_part, centre, dir);
   std::printf(
-      "grown by %zu (start) and %zu (end) particles; largest distance from the crack line %.3e m (start), "
+      "grown by %zu (start) and %zu (end) steps; largest distance from the crack line %.3e m (start), "
       "%.3e m (end), %.2f and %.2f deg over the grown length\n",
       start_part.size(), end_part.size(), start_off, end_off, std::atan(start_off / grown) * 180 / kPi,
       std::atan(end_off / grown) * 180 / kPi);
@@ -137,10 +138,10 @@ double x_at_height(const std::vector<Vec2>& plane, bool from_end, double y) {
 
 struct Turned {
   std::vector<Vec2> plane;
-  std::size_t start_initial = 0, end_initial = 0;  // indices of the initial tips in plane
-  double start_heading = 0, end_heading = 0;       // deg
-  int count_gap = 0;                               // largest difference of the tips' growth counts
-  double step_gap = 0;  // m, the largest distance from point symmetry of the k-th new particles of the two tips
+  int start_grown = 0, end_grown = 0;         // growth steps of each tip
+  double start_heading = 0, end_heading = 0;  // deg
+  int count_gap = 0;                          // largest difference of the tips' growth counts
+  double step_gap = 0;  // m, the largest distance from point symmetry of the tips of the k-th growth steps
   double start_crossing = 0, end_crossing = 0;  // m, x where the start (end) tip's path crosses y = -1.5 (+1.5) m
 };
 
@@ -208,8 +209,8 @@ Turned turn_in_anisotropic_stress(double h, double length) {
   }
   Turned out;
   out.plane = solid.cracks()[0].plane();
-  out.start_initial = static_cast<std::size_t>(log.empty() ? 0 : log.back().start_grown);
-  out.end_initial = out.start_initial + static_cast<std::size_t>(std::lround(4 * kA / h));
+  out.start_grown = log.empty() ? 0 : log.back().start_grown;
+  out.end_grown = log.empty() ? 0 : log.back().end_grown;
   out.start_heading = heading(out.plane, false, 2 * h);
   out.end_heading = heading(out.plane, true, 2 * h);
   const Vec2 centre(h / 2, 0);
@@ -223,11 +224,10 @@ Turned turn_in_anisotropic_stress(double h, double length) {
   out.start_crossing = x_at_height(out.plane, false, -1.5);
   out.end_crossing = x_at_height(out.plane, true, 1.5);
   std::printf(
-      "h = a/%.0f: start tip grew %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = -1.5 m at "
-      "x = %+.4f m; end tip %zu steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = 1.5 m at x = %+.4f m\n",
-      kA / h, out.start_initial, out.plane.front().x(), out.plane.front().y(), out.start_heading, out.start_crossing,
-      out.plane.size() - 1 - out.end_initial, out.plane.back().x(), out.plane.back().y(), out.end_heading,
-      out.end_crossing);
+      "h = a/%.0f: start tip grew %d steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = -1.5 m at "
+      "x = %+.4f m; end tip %d steps to (%+.4f, %+.4f), heading %.2f deg, crosses y = 1.5 m at x = %+.4f m\n",
+      kA / h, out.start_grown, out.plane.front().x(), out.plane.front().y(), out.start_heading, out.start_crossing,
+      out.end_grown, out.plane.back().x(), out.plane.back().y(), out.end_heading, out.end_crossing);
   std::printf(
       "point symmetry about the centre (%.3f, 0): tips at the end %.4f m from symmetric, the k-th new particles "
       "of the two tips at most %.4f m, crossings %.4f m; growth counts differed by at most %d\n",
@@ -254,7 +254,7 @@ Turned turn_in_anisotropic_stress(double h, double length) {
 // steps before the end tip's second (counts 3 : 1) and ended one step ahead
 // (25 : 24). Growth there is now driven by (K_I^2 + K_II^2)/E' (the crack
 // bends by more than 30 deg in the domain): the tips grow at the same checks
-// (24 : 24). Asserted: the k-th new particles of the two tips point-symmetric
+// (24 : 24). Asserted: the tips of the k-th growth steps point-symmetric
 // within a step, and the counts within one step (issue 18).
 // HFMPM_OBLIQUE_CELLS=n runs at a/n.
 TEST(ObliqueGrowth, AnisotropicStressTurnsPerpendicularToLeastCompression) {

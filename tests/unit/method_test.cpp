@@ -148,6 +148,104 @@ TEST(Method, ToughnessDominatedCrackSettlesAfterEachStep) {
   EXPECT_DOUBLE_EQ(with_method(written).solid().mpm().fracture().release_transits(), 1);
 }
 
+// Turning tips wait front_settle_transits shear transits of their J domain
+// after each growth step, which caps them at g c_s / (N j_outer). The field
+// well of issue 46 at 30 degrees (E 20 GPa, nu 0.25, 2600 kg/m^3, water,
+// 1e-3 m^2/s for 100 s, a 5 m wing, 2.29 m cells; Km 0.97): the P-wave rule
+// gives a scaling of 1000, whose cap (0.29 m/s) held the tips below the
+// M-vertex's speed at three notch lengths. The scaling is lowered until the
+// cap reaches that speed; a straight crack, a scene's shorter wait, or a
+// crack that does not wait for its fluid keep the P-wave rule.
+TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
+  Physics p;
+  p.youngs_modulus = 2e10;
+  p.poisson_ratio = 0.25;
+  p.density = 2600;
+  p.toughness = 1e6;
+  p.viscosity = 1e-3;
+  p.total_rate = 1e-3;
+  p.end_s = 100;
+  p.effective_s = 99.5;
+  p.notch = 5;
+  const double h = 2.29, reach = 231;
+  const Method straight = derive(p, h, reach);
+  ASSERT_TRUE(straight.expected.viscosity_dominated);
+  ASSERT_DOUBLE_EQ(straight.growth_cells, 1.0 / 16);
+  EXPECT_DOUBLE_EQ(straight.density_scaling, 1000);
+  EXPECT_FALSE(straight.front_settle_capped);
+
+  // The M-vertex's speed when the crack reaches three notch lengths, 2/3 l / t.
+  const double e_prime = p.youngs_modulus / (1 - p.poisson_ratio * p.poisson_ratio);
+  const double l_end = m_vertex(e_prime, p.viscosity, p.total_rate, p.effective_s).half_length;
+  const double t_3 = p.effective_s * std::pow(3 * p.notch / l_end, 1.5);
+  const double speed = 2.0 / 3.0 * 3 * p.notch / t_3;
+  EXPECT_NEAR(speed, 0.539, 0.001);
+  const double c_s = std::sqrt(p.youngs_modulus / (2 * (1 + p.poisson_ratio)) / p.density);
+  auto cap = [&](const Method& d, double transits) {
+    return d.growth_cells * c_s / std::sqrt(d.density_scaling) / (transits * 3);
+  };
+  EXPECT_LT(cap(straight, 4), 0.3);  // the old scaling's cap
+
+  Chosen turning;
+  turning.turning_waits = true;
+  const Method turned = derive(p, h, reach, turning);
+  EXPECT_TRUE(turned.front_settle_capped);
+  EXPECT_NEAR(turned.early_tip_speed, speed, 1e-9);
+  EXPECT_DOUBLE_EQ(turned.density_scaling, 280);  // two digits, rounded down
+  EXPECT_GE(cap(turned, 4), speed);
+  EXPECT_LT(cap(turned, 4), 1.05 * speed);  // no slower than the rule needs
+  // The damping follows the lower scaling (a faster body).
+  EXPECT_GT(turned.damping, straight.damping);
+
+  // A shorter wait the scene chose needs less; one of a transit, none.
+  turning.front_settle_transits = 1;
+  const Method short_wait = derive(p, h, reach, turning);
+  EXPECT_FALSE(short_wait.front_settle_capped);
+  EXPECT_DOUBLE_EQ(short_wait.density_scaling, 1000);
+  // A scaling the scene sets is kept.
+  turning.front_settle_transits = 4;
+  turning.density_scaling = 500;
+  EXPECT_DOUBLE_EQ(derive(p, h, reach, turning).density_scaling, 500);
+}
+
+// The same through a scene: the lab KGD (kgd-viscosity-ci's physics) turned
+// to 30 degrees under 150 / 100 kPa. Its tips turn and wait; with the wait
+// the scene sets, 40 transits, the cap binds and lowers the scaling. Set
+// STRAIGHT, or with the zero lag the scene turned off, it does not.
+TEST(Method, ASceneTurningTipsWaitSetsItsScaling) {
+  scene::Scene written = physics_only();
+  auto& m = *written.mutable_solid()->mutable_mpm();
+  for (auto& r : *m.mutable_regions()) r.mutable_initial_stress()->set_xx_pa(-1.5e5);
+  auto& crack = *m.mutable_cracks(0);
+  crack.set_x_m(1, 0.15 * std::cos(std::numbers::pi / 6));
+  crack.set_y_m(1, 0.15 * std::sin(std::numbers::pi / 6));
+  m.mutable_fracture()->set_front_settle_transits(40);
+  std::vector<Setting> applied;
+  const scene::Scene turned = with_method(written, &applied);
+  ASSERT_EQ(turned.solid().mpm().fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
+  const auto p = physics_of(written);
+  ASSERT_TRUE(p);
+  Chosen chosen;
+  chosen.turning_waits = true;
+  chosen.front_settle_transits = 40;
+  const Method d = derive(p->physics, p->cell, p->reach, chosen);
+  EXPECT_DOUBLE_EQ(turned.solid().mpm().density_scaling(), d.density_scaling);
+  const Setting* scaling = find(applied, "solid.mpm.density_scaling");
+  ASSERT_TRUE(scaling);
+  EXPECT_TRUE(d.front_settle_capped);
+  EXPECT_LT(d.density_scaling, derive(p->physics, p->cell, p->reach).density_scaling);
+  EXPECT_THAT(scaling->rule, HasSubstr("turning tips' wait"));
+
+  written.mutable_solid()->mutable_mpm()->mutable_fracture()->set_direction(scene::FractureSpec::STRAIGHT);
+  EXPECT_DOUBLE_EQ(with_method(written).solid().mpm().density_scaling(),
+                   derive(p->physics, p->cell, p->reach).density_scaling);
+  written.mutable_solid()->mutable_mpm()->mutable_fracture()->set_direction(scene::FractureSpec::MAX_HOOP_STRESS);
+  EXPECT_DOUBLE_EQ(with_method(written).solid().mpm().density_scaling(), d.density_scaling);
+  written.mutable_fluid()->mutable_mpm()->set_lag(scene::MpmFluid::ZERO_PRESSURE);
+  EXPECT_DOUBLE_EQ(with_method(written).solid().mpm().density_scaling(),
+                   derive(p->physics, p->cell, p->reach).density_scaling);
+}
+
 // A well inside the body: the inlet's rate is both wings', the notch half the crack.
 TEST(Method, InletVertexSharesTheRateBetweenTheWings) {
   scene::Scene written = physics_only();

@@ -17,6 +17,10 @@ constexpr double kForever = std::numeric_limits<double>::infinity();
 // opening the grid gives the faces is linear within a cell, so at most two
 // independent openings per cell (docs/solid.md, "Growth").
 constexpr double kMinSegmentCells = 0.5;
+// A turning tip's growth step lengthens its short tip segment as a straight
+// one does when the old tip stays within this many cells of the lengthened
+// segment: the crack then moves by less than the grid resolves.
+constexpr double kMergeOffsetCells = 0.01;
 // A kinking tip grows only where its K's carry between this share of J and
 // its inverse: kKShare J <= (K_I^2 + K_II^2) / E' <= J / kKShare
 // (growth_direction_known below).
@@ -171,11 +175,24 @@ int Solver::propagate() {
     // cell apart"). The moved tip particle stands for the material point at
     // its new place, so its reference position moves with it by the same
     // estimate a new particle there would get.
+    // A turning tip does the same when the old tip lies within
+    // kMergeOffsetCells of the lengthened segment (it turns by less than the
+    // grid resolves; sixteenth-cell particles of a turning field well made
+    // the fluid's Newton steps stall).
     const auto& plane = crack.plane();
     const std::size_t n = plane.size();
-    const double length = tip.at_end ? (plane[n - 1] - plane[n - 2]).norm() : (plane[0] - plane[1]).norm();
+    const Vec2& before = tip.at_end ? plane[n - 2] : plane[1];
+    const Vec2& last = tip.at_end ? plane[n - 1] : plane[0];
+    const double length = (last - before).norm();
     const double grown = length + config_.fracture.growth_cells * h;
-    if (straight && grown <= (kMinSegmentCells + 0.5 * config_.fracture.growth_cells) * h) {
+    const Vec2 chord = next - before;
+    const Vec2 off = last - before;
+    const double offset = std::abs(chord.x() * off.y() - chord.y() * off.x()) / chord.norm();
+    // ... and the step carries the segment on past the old tip (a step that
+    // turns back along its own segment would shorten it).
+    const bool ahead = chord.dot(off) >= length * (length + 0.5 * config_.fracture.growth_cells * h);
+    const bool in_line = straight || (offset <= kMergeOffsetCells * h && ahead);
+    if (in_line && grown <= (kMinSegmentCells + 0.5 * config_.fracture.growth_cells) * h) {
       crack.move_tip(tip.at_end, next, reference);
     } else if (tip.at_end) {
       crack.append(next, reference);

@@ -63,24 +63,37 @@ struct Setting {
   std::string key, value, rule;
 };
 
+// The numerical keys a scene chose itself, which the rest of the method
+// follows: a density scaling or a growth step (> 0) used instead of the
+// derived one, and the settling wait of turning tips.
+struct Chosen {
+  double density_scaling = 0, growth_cells = 0;
+  // The tips turn (MAX_HOOP_STRESS) and wait for the fluid front (zero lag):
+  // after each growth step they also wait front_settle_transits shear
+  // transits of the J domain, j_outer_cells h / c_s.
+  bool turning_waits = false;
+  double front_settle_transits = 4, j_outer_cells = 3;
+};
+
 // The numerical method of a fluid-driven crack, for a cell size and a body
-// reaching `reach` metres from the well; a density scaling or a growth step
-// the scene chose (> 0) is used instead of the derived one for the rest.
+// reaching `reach` metres from the well.
 struct Method {
   Expected expected;
   double growth_cells = 0.25;  // cells per growth step, and the zero-lag wait
   bool settle = false;         // toughness: wait for the opening after a step
   double density_scaling = 1;
-  double damping = 0;          // 1/s, mass-proportional on the grid
-  double virtual_opening = 0;  // m
-  double lag_pressure = 0;     // Pa, the dry tip zone's (matched closure)
-  double body_omega = 0;       // rad/s, the body's lowest mode at the scaled wave speed
-  double t_3 = 0;              // s, the time the crack takes to three notch lengths
-  double scaled_c = 0;         // m/s, the scaled P-wave speed
-  double tip_speed = 0;        // m/s, the tip's mean speed over the injection
+  double damping = 0;                // 1/s, mass-proportional on the grid
+  double virtual_opening = 0;        // m
+  double lag_pressure = 0;           // Pa, the dry tip zone's (matched closure)
+  double body_omega = 0;             // rad/s, the body's lowest mode at the scaled wave speed
+  double t_3 = 0;                    // s, the time the crack takes to three notch lengths
+  double scaled_c = 0;               // m/s, the scaled P-wave speed
+  double tip_speed = 0;              // m/s, the tip's mean speed over the injection
+  double early_tip_speed = 0;        // m/s, the tip's speed when the crack reaches three notch lengths
+  bool front_settle_capped = false;  // the turning tips' wait set the density scaling
   std::vector<Setting> settings;
 };
-Method derive(const Physics& physics, double cell, double reach, double chosen_scaling = 0, double chosen_growth = 0);
+Method derive(const Physics& physics, double cell, double reach, const Chosen& chosen = {});
 
 // The physics of a scene's fluid-driven crack: an MPM solid and an MPM fluid
 // with a flow-rate inlet. Empty, with `why_not` saying so, otherwise.
