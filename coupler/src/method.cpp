@@ -105,8 +105,13 @@ Method derive(const Physics& p, double h, double reach, const Chosen& chosen) {
   d.t_3 = p.effective_s * std::pow(std::min(1.0, 3 * p.notch / l_end), 1.5);
   d.early_tip_speed = 2.0 / 3.0 * l_3 / d.t_3;
   if (chosen.turning_waits && chosen.front_settle_transits > 0) {
+    // In the slowest rock of the body: a wing that runs into a softer layer
+    // waits longer there (a wellbore beside a layer of half the modulus, its
+    // tips turning, held both wings at 0.535 m at 5 s where the straight
+    // ones ran to 0.557 and 0.609 m).
+    const double c_s_slowest = p.slowest_shear_speed > 0 ? std::min(c_s, p.slowest_shear_speed) : c_s;
     const double c_s_needed = chosen.front_settle_transits * chosen.j_outer_cells * d.early_tip_speed / d.growth_cells;
-    const double capped = std::pow(c_s / c_s_needed, 2);
+    const double capped = std::pow(c_s_slowest / c_s_needed, 2);
     if (capped < scaling) {
       scaling = capped;
       d.front_settle_capped = true;

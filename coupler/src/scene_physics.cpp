@@ -107,6 +107,78 @@ double reach(const scene::MpmSolid& m, double x, double y) {
   return std::min(std::max(x - x0, x1 - x), std::max(y - y0, y1 - y));
 }
 
+// The region a point lies in: the last listed that contains it (a later
+// region wins), or null outside the body.
+const scene::RegionSpec* region_at(const scene::MpmSolid& m, double x, double y) {
+  const scene::RegionSpec* found = nullptr;
+  for (const auto& r : m.regions())
+    if (contains(r, x, y)) found = &r;
+  return found;
+}
+
+// The body is its own mirror image about the line of a straight crack along
+// x (y = c) or y (x = c): at every cell centre and its mirror point the same
+// material and in-situ stress (its shear reversed), the mirrored edges loaded
+// and held alike, no shear traction, and no other crack. Then K_II = 0 at
+// both tips by symmetry and the crack grows straight on, whatever lies ahead
+// of it (a layer across its path).
+bool mirror_symmetric(const scene::MpmSolid& m, bool along_x, double c) {
+  if (m.cracks_size() != 1 || !(m.cell_size_m() > 0)) return false;
+  const auto& g = m.grid();
+  const double h = m.cell_size_m();
+  const double lo = along_x ? g.y_min_m() : g.x_min_m(), hi = along_x ? g.y_max_m() : g.x_max_m();
+  if (std::abs(lo + hi - 2 * c) > 1e-6 * h) return false;
+  // Edges: the two across the line swap; shear tractions and fixed boxes are
+  // not compared (the scene is then not taken as symmetric).
+  const scene::Edge a = along_x ? scene::BOTTOM : scene::LEFT, b = along_x ? scene::TOP : scene::RIGHT;
+  auto traction_text = [&](scene::Edge e) {
+    std::string text;
+    for (const auto& t : m.tractions())
+      if (t.edge() == e) text += t.normal_pa().SerializeAsString() + "|";
+    return text;
+  };
+  for (const auto& t : m.tractions())
+    if (t.has_shear_pa()) return false;
+  if (traction_text(a) != traction_text(b)) return false;
+  auto silent = [&](scene::Edge e) { return std::count(m.silent_edges().begin(), m.silent_edges().end(), e); };
+  if (silent(a) != silent(b)) return false;
+  for (const auto& k : m.constraints()) {
+    if (k.has_fixed_box()) return false;
+    const bool across = along_x ? k.has_symmetry_y_m() : k.has_symmetry_x_m();
+    if (!across) continue;
+    const double at = along_x ? k.symmetry_y_m() : k.symmetry_x_m();
+    bool mirrored = false;
+    for (const auto& o : m.constraints()) {
+      const bool same_kind = along_x ? o.has_symmetry_y_m() : o.has_symmetry_x_m();
+      if (same_kind && std::abs((along_x ? o.symmetry_y_m() : o.symmetry_x_m()) - (2 * c - at)) <= 1e-6 * h)
+        mirrored = true;
+    }
+    if (!mirrored) return false;
+  }
+  // Regions: cell centres, at most about 400 samples along each axis.
+  const int nx = static_cast<int>(std::ceil((g.x_max_m() - g.x_min_m()) / h - 1e-9));
+  const int ny = static_cast<int>(std::ceil((g.y_max_m() - g.y_min_m()) / h - 1e-9));
+  if (nx <= 0 || ny <= 0) return false;
+  const int sx = std::max(1, nx / 400), sy = std::max(1, ny / 400);
+  for (int i = 0; i < nx; i += sx) {
+    for (int j = 0; j < ny; j += sy) {
+      const double x = g.x_min_m() + (i + 0.5) * h, y = g.y_min_m() + (j + 0.5) * h;
+      const double mx = along_x ? x : 2 * c - x, my = along_x ? 2 * c - y : y;
+      const scene::RegionSpec* r = region_at(m, x, y);
+      const scene::RegionSpec* q = region_at(m, mx, my);
+      if (!r || !q) {
+        if (r != q) return false;
+        continue;
+      }
+      const auto &s1 = r->initial_stress(), &s2 = q->initial_stress();
+      if (r->material() != q->material() || s1.xx_pa() != s2.xx_pa() || s1.yy_pa() != s2.yy_pa() ||
+          s1.xy_pa() != -s2.xy_pa())
+        return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_not) {
@@ -191,16 +263,25 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
   p.normal_stress = sxx * nx * nx + syy * ny * ny + 2 * sxy * nx * ny;
   p.shear_stress = sxx * tx * nx + syy * ty * ny + sxy * (tx * ny + ty * nx);
   p.minimum_stress = 0.5 * (sxx + syy) - std::hypot(0.5 * (sxx - syy), sxy);
-  // Straight on by symmetry only in a homogeneous body: one material and one
-  // in-situ stress in every region (a layer of another rock beside the crack
-  // turns it).
+  // Straight on by symmetry in a homogeneous body (one material and one
+  // in-situ stress in every region), or in one that is its own mirror image
+  // about the crack's line (a layer across the path); a layer of another
+  // rock beside the crack turns it.
   bool homogeneous = true;
   for (const auto& r : m.regions()) {
     const auto& o = r.initial_stress();
     homogeneous = homogeneous && r.material() == region->material() && o.xx_pa() == st.xx_pa() &&
                   o.yy_pa() == st.yy_pa() && o.xy_pa() == st.xy_pa();
   }
-  p.symmetric = straight && homogeneous && std::abs(p.shear_stress) <= 1e-9 * std::max(std::abs(sxx), std::abs(syy));
+  const bool along_x = std::abs(dy0) <= 1e-12 * std::abs(dx0), along_y = std::abs(dx0) <= 1e-12 * std::abs(dy0);
+  const bool mirrored = straight && (along_x || along_y) && mirror_symmetric(m, along_x, along_x ? y : x);
+  for (const auto& mat : m.materials()) {
+    const double speed = std::sqrt(mat.youngs_modulus_pa() / (2 * (1 + mat.poisson_ratio())) / mat.density_kg_m3());
+    if (std::isfinite(speed) && speed > 0 && (p.slowest_shear_speed == 0 || speed < p.slowest_shear_speed))
+      p.slowest_shear_speed = speed;
+  }
+  p.symmetric = straight && (homogeneous || mirrored) &&
+                std::abs(p.shear_stress) <= 1e-9 * std::max(std::abs(sxx), std::abs(syy));
 
   out.cell = m.cell_size_m();
   out.reach = reach(m, x, y);

@@ -167,8 +167,8 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
                         : "the tip leads the fluid front by at most 2 steps, 2.5% of three notch lengths (" +
                               approx(3 * p.notch) + " m)");
     derive_key(s, applied, "solid.mpm.fracture.direction", p.symmetric ? "STRAIGHT" : "MAX_HOOP_STRESS",
-               p.symmetric ? "a straight notch in a homogeneous body with no in-situ shear on it: straight on by "
-                             "symmetry"
+               p.symmetric ? "a straight notch with no in-situ shear on it, in a homogeneous body or one that is its "
+                             "own mirror image about the notch's line: straight on by symmetry"
                            : "the in-situ stress puts " + approx(std::abs(p.shear_stress)) +
                                  " Pa of shear on the notch, the crack is bent or the body is not homogeneous: the "
                                  "tips turn by maximum hoop stress");

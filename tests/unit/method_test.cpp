@@ -197,6 +197,14 @@ TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
   // The damping follows the lower scaling (a faster body).
   EXPECT_GT(turned.damping, straight.damping);
 
+  // A rock of half the modulus elsewhere in the body: the wait is longest
+  // there, and the scaling halves.
+  p.slowest_shear_speed = c_s / std::sqrt(2.0);
+  const Method softer = derive(p, h, reach, turning);
+  EXPECT_DOUBLE_EQ(softer.density_scaling, 140);
+  EXPECT_GE(softer.growth_cells * p.slowest_shear_speed / std::sqrt(softer.density_scaling) / 12, speed);
+  p.slowest_shear_speed = 0;
+
   // A shorter wait the scene chose needs less; one of a transit, none.
   turning.front_settle_transits = 1;
   const Method short_wait = derive(p, h, reach, turning);
@@ -303,6 +311,51 @@ TEST(Method, LayeredBodyTurnsByHoopStress) {
   ASSERT_TRUE(p);
   EXPECT_FALSE(p->physics.symmetric);
   EXPECT_EQ(with_method(written).solid().mpm().fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
+}
+
+// A layer of another rock across the crack's path, the body its own mirror
+// image about the crack's line: K_II = 0 by symmetry, the crack grows
+// straight on. Break the mirror (the layer cut short on one side, the top
+// edge loaded differently, a second crack, a shear in-situ stress) and the
+// tips turn.
+TEST(Method, ALayerAcrossThePathKeepsTheCrackStraight) {
+  scene::Scene written = physics_only();
+  auto& m = *written.mutable_solid()->mutable_mpm();
+  auto* soft = m.add_materials();
+  *soft = m.materials(0);
+  soft->set_name("soft");
+  soft->set_youngs_modulus_pa(5e6);
+  auto* across = m.add_regions();
+  across->set_material("soft");
+  across->mutable_rectangle()->set_x_min_m(0.5);
+  across->mutable_rectangle()->set_x_max_m(3);
+  across->mutable_rectangle()->set_y_min_m(-3.05);
+  across->mutable_rectangle()->set_y_max_m(3.05);
+  *across->mutable_initial_stress() = m.regions(0).initial_stress();
+  const int last = m.regions_size() - 1;
+  auto direction = [](const scene::Scene& s) { return with_method(s).solid().mpm().fracture().direction(); };
+  ASSERT_TRUE(physics_of(written));
+  EXPECT_TRUE(physics_of(written)->physics.symmetric);
+  EXPECT_EQ(direction(written), scene::FractureSpec::STRAIGHT);
+
+  scene::Scene cut_short = written;
+  cut_short.mutable_solid()->mutable_mpm()->mutable_regions(last)->mutable_rectangle()->set_y_max_m(2);
+  EXPECT_EQ(direction(cut_short), scene::FractureSpec::MAX_HOOP_STRESS);
+
+  scene::Scene top_loaded = written;
+  for (auto& t : *top_loaded.mutable_solid()->mutable_mpm()->mutable_tractions())
+    if (t.edge() == scene::TOP) t.mutable_normal_pa()->set_constant(-2e5);
+  EXPECT_EQ(direction(top_loaded), scene::FractureSpec::MAX_HOOP_STRESS);
+
+  scene::Scene two_cracks = written;
+  auto* second = two_cracks.mutable_solid()->mutable_mpm()->add_cracks();
+  *second = two_cracks.solid().mpm().cracks(0);
+  for (auto& y : *second->mutable_y_m()) y = 1;
+  EXPECT_EQ(direction(two_cracks), scene::FractureSpec::MAX_HOOP_STRESS);
+
+  scene::Scene sheared = written;
+  for (auto& r : *sheared.mutable_solid()->mutable_mpm()->mutable_regions()) r.mutable_initial_stress()->set_xy_pa(1e3);
+  EXPECT_EQ(direction(sheared), scene::FractureSpec::MAX_HOOP_STRESS);
 }
 
 // A dry scene gets the faces from the material and, with its in-situ
