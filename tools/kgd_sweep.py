@@ -239,9 +239,9 @@ def uniform_particles(tree, n):
 
 # name: (settings, a cell size h or None, which sweeps: "both", "full" or "quick").
 # The full sweep varies one setting at a time around kgd-viscosity.scene's own (h = 0.04 m,
-# cfl 0.5, density scaling 10, grid damping 5 /s, exchange every step, in-process, 1 particle
-# per cell in the far field and 2 x 2 around the crack); the quick one around the CI scene's
-# (h = 0.035 m, cfl 0.4, ipc).
+# cfl 0.5, exchange every step, in-process, 1 particle per cell in the far field and 2 x 2
+# around the crack, the method derived: density scaling 13 and grid damping 3.6 /s at its
+# cell); the quick one around the CI scene's (h = 0.035 m, cfl 0.4, ipc).
 CASES = {
     "base": ([], None, "both"),
     "h0.07": ([], 0.07, "full"), "h0.05": ([], 0.05, "both"), "h0.035": ([], 0.035, "full"),
