@@ -93,6 +93,16 @@ Method derive(const Physics& p, double h, double reach, const Chosen& chosen) {
     const double c_s_needed = 2 * l_end * d.tip_speed / (d.growth_cells * h);
     scaling = std::min(scaling, std::pow(c_s / c_s_needed, 2));
   }
+  // The turning tips' wait after each growth step: 4 shear transits of the
+  // J domain after a quarter-cell step (the layered study that set it:
+  // docs/verification.md, "Layered medium"), in proportion to the step's
+  // share of that load change below it. A sixteenth-cell step waited 4
+  // transits too before, and the fluid-driven field well at 30 degrees then
+  // reached 30.9 m at 100 s, with 1 transit 45.5 m (the aligned well 45.2 m);
+  // the viscosity-dominated lab well at 30 degrees grew 91 / 115 / 132 mm
+  // beyond its notch at a sixteenth / eighth / quarter cell (the M-vertex 128 mm).
+  d.front_settle_transits =
+      chosen.front_settle_transits >= 0 ? chosen.front_settle_transits : std::min(4.0, 16 * d.growth_cells);
   // Tips that turn wait, after each growth step, front_settle_transits
   // shear transits of their J domain once the fluid front is within reach:
   // that caps them at g c_s / (front_settle_transits j_outer_cells), whatever
@@ -104,13 +114,13 @@ Method derive(const Physics& p, double h, double reach, const Chosen& chosen) {
   const double l_3 = std::min(3 * p.notch, l_end);
   d.t_3 = p.effective_s * std::pow(std::min(1.0, 3 * p.notch / l_end), 1.5);
   d.early_tip_speed = 2.0 / 3.0 * l_3 / d.t_3;
-  if (chosen.turning_waits && chosen.front_settle_transits > 0) {
+  if (chosen.turning_waits && d.front_settle_transits > 0) {
     // In the slowest rock of the body: a wing that runs into a softer layer
     // waits longer there (a wellbore beside a layer of half the modulus, its
     // tips turning, held both wings at 0.535 m at 5 s where the straight
     // ones ran to 0.557 and 0.609 m).
     const double c_s_slowest = p.slowest_shear_speed > 0 ? std::min(c_s, p.slowest_shear_speed) : c_s;
-    const double c_s_needed = chosen.front_settle_transits * chosen.j_outer_cells * d.early_tip_speed / d.growth_cells;
+    const double c_s_needed = d.front_settle_transits * chosen.j_outer_cells * d.early_tip_speed / d.growth_cells;
     const double capped = std::pow(c_s_slowest / c_s_needed, 2);
     if (capped < scaling) {
       scaling = capped;

@@ -132,7 +132,7 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
                               ? fracture.max_lag_cells() >= 0
                               : s.fluid().mpm().lag() != scene::MpmFluid::ZERO_PRESSURE || !is_set(s, "fluid.mpm.lag");
     chosen.turning_waits = turning && zero_lag;
-    chosen.front_settle_transits = fracture.front_settle_transits();
+    if (fracture.has_front_settle_transits()) chosen.front_settle_transits = fracture.front_settle_transits();
     if (fracture.has_j_outer_cells()) chosen.j_outer_cells = fracture.j_outer_cells();
     const Method d = derive(p, physics->cell, physics->reach, chosen);
     const Expected& x = d.expected;
@@ -172,6 +172,11 @@ scene::Scene with_method(const scene::Scene& scene, std::vector<Setting>* applie
                            : "the in-situ stress puts " + approx(std::abs(p.shear_stress)) +
                                  " Pa of shear on the notch, the crack is bent or the body is not homogeneous: the "
                                  "tips turn by maximum hoop stress");
+    if (chosen.turning_waits) {
+      derive_key(s, applied, "solid.mpm.fracture.front_settle_transits", num(d.front_settle_transits),
+                 "turning tips wait after each growth step 4 shear transits of the J domain per quarter cell of "
+                 "step (at most 4)");
+    }
     if (s.fluid().mpm().lag() != scene::MpmFluid::ZERO_PRESSURE || !is_set(s, "fluid.mpm.lag")) {
       derive_key(s, applied, "solid.mpm.fracture.max_lag_cells", num(d.growth_cells),
                  "zero lag: the tip waits for the fluid front within a growth step");

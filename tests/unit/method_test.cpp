@@ -153,9 +153,9 @@ TEST(Method, ToughnessDominatedCrackSettlesAfterEachStep) {
 // well of issue 46 at 30 degrees (E 20 GPa, nu 0.25, 2600 kg/m^3, water,
 // 1e-3 m^2/s for 100 s, a 5 m wing, 2.29 m cells; Km 0.97): the P-wave rule
 // gives a scaling of 1000, whose cap (0.29 m/s) held the tips below the
-// M-vertex's speed at three notch lengths. The scaling is lowered until the
-// cap reaches that speed; a straight crack, a scene's shorter wait, or a
-// crack that does not wait for its fluid keep the P-wave rule.
+// M-vertex's speed at three notch lengths. The derived wait is shorter for
+// a shorter step; where a wait still caps the tips below that speed the
+// scaling is lowered until the cap reaches it.
 TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
   Physics p;
   p.youngs_modulus = 2e10;
@@ -186,8 +186,22 @@ TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
   };
   EXPECT_LT(cap(straight, 4), 0.3);  // the old scaling's cap
 
+  // The derived wait: 4 transits per quarter cell of step, 1 at this
+  // sixteenth-cell step, whose cap (1.15 m/s) is above the speed: the
+  // P-wave rule's scaling stands.
   Chosen turning;
   turning.turning_waits = true;
+  const Method derived = derive(p, h, reach, turning);
+  EXPECT_DOUBLE_EQ(derived.front_settle_transits, 1);
+  EXPECT_FALSE(derived.front_settle_capped);
+  EXPECT_DOUBLE_EQ(derived.density_scaling, 1000);
+  EXPECT_GE(cap(derived, 1), 2 * speed);
+  EXPECT_DOUBLE_EQ(derive(p, h, reach, Chosen{0, 0.125, true}).front_settle_transits, 2);
+  EXPECT_DOUBLE_EQ(derive(p, h, reach, Chosen{0, 0.5, true}).front_settle_transits, 4);
+
+  // The wait of 4 transits a scene may set caps the tips below the speed:
+  // the scaling is lowered until the cap reaches it.
+  turning.front_settle_transits = 4;
   const Method turned = derive(p, h, reach, turning);
   EXPECT_TRUE(turned.front_settle_capped);
   EXPECT_NEAR(turned.early_tip_speed, speed, 1e-9);
@@ -205,11 +219,11 @@ TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
   EXPECT_GE(softer.growth_cells * p.slowest_shear_speed / std::sqrt(softer.density_scaling) / 12, speed);
   p.slowest_shear_speed = 0;
 
-  // A shorter wait the scene chose needs less; one of a transit, none.
-  turning.front_settle_transits = 1;
-  const Method short_wait = derive(p, h, reach, turning);
-  EXPECT_FALSE(short_wait.front_settle_capped);
-  EXPECT_DOUBLE_EQ(short_wait.density_scaling, 1000);
+  // No wait, no cap.
+  turning.front_settle_transits = 0;
+  const Method no_wait = derive(p, h, reach, turning);
+  EXPECT_FALSE(no_wait.front_settle_capped);
+  EXPECT_DOUBLE_EQ(no_wait.density_scaling, 1000);
   // A scaling the scene sets is kept.
   turning.front_settle_transits = 4;
   turning.density_scaling = 500;

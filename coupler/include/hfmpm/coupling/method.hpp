@@ -73,9 +73,9 @@ struct Chosen {
   double density_scaling = 0, growth_cells = 0;
   // The tips turn (MAX_HOOP_STRESS) and wait for the fluid front (zero lag):
   // after each growth step they also wait front_settle_transits shear
-  // transits of the J domain, j_outer_cells h / c_s.
+  // transits of the J domain, j_outer_cells h / c_s (< 0: derived).
   bool turning_waits = false;
-  double front_settle_transits = 4, j_outer_cells = 3;
+  double front_settle_transits = -1, j_outer_cells = 3;
 };
 
 // The numerical method of a fluid-driven crack, for a cell size and a body
@@ -94,6 +94,7 @@ struct Method {
   double tip_speed = 0;              // m/s, the tip's mean speed over the injection
   double early_tip_speed = 0;        // m/s, the tip's speed when the crack reaches three notch lengths
   bool front_settle_capped = false;  // the turning tips' wait set the density scaling
+  double front_settle_transits = 4;  // the turning tips' wait after each step, in J-domain transits
   std::vector<Setting> settings;
 };
 Method derive(const Physics& physics, double cell, double reach, const Chosen& chosen = {});
