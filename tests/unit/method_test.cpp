@@ -308,19 +308,26 @@ TEST(Method, InclinedNotchUnderAnisotropicStressTurns) {
   EXPECT_NEAR(s.fluid().mpm().initial_fill().pressure_pa(), 112500, 1e-6);
 }
 
-// A layer of another rock beside the crack breaks the symmetry: the tips may turn.
-TEST(Method, LayeredBodyTurnsByHoopStress) {
-  scene::Scene written = physics_only();
-  auto& m = *written.mutable_solid()->mutable_mpm();
+// A region of a rock of half the modulus, in the far field's in-situ
+// stress; its shape is the caller's.
+scene::RegionSpec* add_soft_region(scene::Scene& s) {
+  auto& m = *s.mutable_solid()->mutable_mpm();
   auto* soft = m.add_materials();
   *soft = m.materials(0);
   soft->set_name("soft");
   soft->set_youngs_modulus_pa(5e6);
-  auto* layer = m.add_regions();
-  layer->set_material("soft");
+  auto* region = m.add_regions();
+  region->set_material("soft");
+  *region->mutable_initial_stress() = m.regions(0).initial_stress();
+  return region;
+}
+
+// A layer of another rock beside the crack breaks the symmetry: the tips may turn.
+TEST(Method, LayeredBodyTurnsByHoopStress) {
+  scene::Scene written = physics_only();
+  auto* layer = add_soft_region(written);
   layer->mutable_layer()->set_y_min_m(0.2);
   layer->mutable_layer()->set_y_max_m(3.05);
-  *layer->mutable_initial_stress() = m.regions(0).initial_stress();
   const auto p = physics_of(written);
   ASSERT_TRUE(p);
   EXPECT_FALSE(p->physics.symmetric);
@@ -334,19 +341,12 @@ TEST(Method, LayeredBodyTurnsByHoopStress) {
 // tips turn.
 TEST(Method, ALayerAcrossThePathKeepsTheCrackStraight) {
   scene::Scene written = physics_only();
-  auto& m = *written.mutable_solid()->mutable_mpm();
-  auto* soft = m.add_materials();
-  *soft = m.materials(0);
-  soft->set_name("soft");
-  soft->set_youngs_modulus_pa(5e6);
-  auto* across = m.add_regions();
-  across->set_material("soft");
+  auto* across = add_soft_region(written);
   across->mutable_rectangle()->set_x_min_m(0.5);
   across->mutable_rectangle()->set_x_max_m(3);
   across->mutable_rectangle()->set_y_min_m(-3.05);
   across->mutable_rectangle()->set_y_max_m(3.05);
-  *across->mutable_initial_stress() = m.regions(0).initial_stress();
-  const int last = m.regions_size() - 1;
+  const int last = written.solid().mpm().regions_size() - 1;
   auto direction = [](const scene::Scene& s) { return with_method(s).solid().mpm().fracture().direction(); };
   ASSERT_TRUE(physics_of(written));
   EXPECT_TRUE(physics_of(written)->physics.symmetric);
