@@ -37,6 +37,18 @@ const Setting* find(const std::vector<Setting>& settings, const std::string& key
   return nullptr;
 }
 
+// kgd-viscosity-ci's physics with its notch turned to 30 degrees and
+// sigma_xx raised to 150 kPa (sigma_H along x, 100 kPa across).
+scene::Scene inclined_30() {
+  scene::Scene written = physics_only();
+  auto& m = *written.mutable_solid()->mutable_mpm();
+  for (auto& r : *m.mutable_regions()) r.mutable_initial_stress()->set_xx_pa(-1.5e5);
+  auto& crack = *m.mutable_cracks(0);
+  crack.set_x_m(1, 0.15 * std::cos(std::numbers::pi / 6));
+  crack.set_y_m(1, 0.15 * std::sin(std::numbers::pi / 6));
+  return written;
+}
+
 TEST(Method, ReadsTheFluidDrivenCracksPhysicsFromAScene) {
   std::string why;
   const auto p = physics_of(physics_only(), &why);
@@ -235,13 +247,8 @@ TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
 // the scene sets, 40 transits, the cap binds and lowers the scaling. Set
 // STRAIGHT, or with the zero lag the scene turned off, it does not.
 TEST(Method, ASceneTurningTipsWaitSetsItsScaling) {
-  scene::Scene written = physics_only();
-  auto& m = *written.mutable_solid()->mutable_mpm();
-  for (auto& r : *m.mutable_regions()) r.mutable_initial_stress()->set_xx_pa(-1.5e5);
-  auto& crack = *m.mutable_cracks(0);
-  crack.set_x_m(1, 0.15 * std::cos(std::numbers::pi / 6));
-  crack.set_y_m(1, 0.15 * std::sin(std::numbers::pi / 6));
-  m.mutable_fracture()->set_front_settle_transits(40);
+  scene::Scene written = inclined_30();
+  written.mutable_solid()->mutable_mpm()->mutable_fracture()->set_front_settle_transits(40);
   std::vector<Setting> applied;
   const scene::Scene turned = with_method(written, &applied);
   ASSERT_EQ(turned.solid().mpm().fracture().direction(), scene::FractureSpec::MAX_HOOP_STRESS);
@@ -289,12 +296,7 @@ TEST(Method, InletVertexSharesTheRateBetweenTheWings) {
 // A notch at 30 degrees under 150 / 100 kPa with sigma_H along x: the tips
 // turn (hoop stress) and the dry zone carries the minimum stress.
 TEST(Method, InclinedNotchUnderAnisotropicStressTurns) {
-  scene::Scene written = physics_only();
-  auto& m = *written.mutable_solid()->mutable_mpm();
-  for (auto& r : *m.mutable_regions()) r.mutable_initial_stress()->set_xx_pa(-1.5e5);
-  auto& crack = *m.mutable_cracks(0);
-  crack.set_x_m(1, 0.15 * std::cos(std::numbers::pi / 6));
-  crack.set_y_m(1, 0.15 * std::sin(std::numbers::pi / 6));
+  scene::Scene written = inclined_30();
   const auto p = physics_of(written);
   ASSERT_TRUE(p);
   EXPECT_NEAR(p->physics.normal_stress, 1.5e5 * 0.25 + 1e5 * 0.75, 1e-6);
