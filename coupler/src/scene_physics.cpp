@@ -256,6 +256,7 @@ std::optional<ScenePhysics> physics_of(const scene::Scene& s, std::string* why_n
   }
   // A well inside the body: the shorter wing, which the fluid's fill may not pass.
   p.notch = both ? std::min(before, length - before) : length;
+  p.two_wings = both;
   // The in-situ stress at the well, compressive, on the crack's plane.
   const auto& st = region->initial_stress();
   const double sxx = -st.xx_pa(), syy = -st.yy_pa(), sxy = -st.xy_pa();

@@ -242,6 +242,37 @@ TEST(Method, TurningTipsWaitNoLongerThanTheirExpectedSpeedAllows) {
   EXPECT_DOUBLE_EQ(derive(p, h, reach, turning).density_scaling, 500);
 }
 
+// With toughness the settling wait after each step counts the whole crack:
+// a well's two wings wait twice as long as one wing, so the scaling that
+// keeps the wait's cap above the tip's final speed is a quarter. The lab
+// toughness well of tests/coupled/inclined_test.cpp at 20 cells per
+// half-length (h = 0.0139 m): 1.0 for two wings, where the P-wave rule's 3.4
+// held its tips to half the reference's speed; at 10 cells the P-wave rule
+// stands.
+TEST(Method, ToughnessWaitCountsBothWingsOfAWell) {
+  Physics p;
+  p.youngs_modulus = 1e7;
+  p.poisson_ratio = 0.25;
+  p.density = 2500;
+  p.toughness = 25e3;
+  p.viscosity = 1e-3;
+  p.total_rate = 8.3e-4;
+  p.end_s = 1.5;
+  p.effective_s = 1.475;
+  p.notch = 0.15;
+  const Method one = derive(p, 0.0139, 3);
+  ASSERT_TRUE(one.settle);
+  p.two_wings = true;
+  const Method two = derive(p, 0.0139, 3);
+  EXPECT_DOUBLE_EQ(one.density_scaling, 3.4);
+  EXPECT_DOUBLE_EQ(two.density_scaling, 1);
+  // The cap g h c_s / (2 L), L the whole crack at the end, against the tip's final speed.
+  const double c_s = std::sqrt(p.youngs_modulus / (2 * (1 + p.poisson_ratio)) / p.density);
+  const double whole = 2 * two.expected.end.half_length;
+  EXPECT_GE(two.growth_cells * 0.0139 * c_s / std::sqrt(two.density_scaling) / (2 * whole), 0.99 * two.tip_speed);
+  EXPECT_DOUBLE_EQ(derive(p, 0.0278, 3).density_scaling, 3.4);
+}
+
 // The same through a scene: the lab KGD (kgd-viscosity-ci's physics) turned
 // to 30 degrees under 150 / 100 kPa. Its tips turn and wait; with the wait
 // the scene sets, 40 transits, the cap binds and lowers the scaling. Set

@@ -43,6 +43,9 @@ struct Physics {
   // material and one in-situ stress in every region): the tips grow straight
   // on by symmetry.
   bool symmetric = true;
+  // Two tips (a well inside the body): the settling wait after a growth step
+  // counts the whole crack, both wings.
+  bool two_wings = false;
   // m/s, the slowest shear-wave speed of the body's materials (0: the rock
   // at the well's): the turning tips' wait is longest there.
   double slowest_shear_speed = 0;
